@@ -1,0 +1,88 @@
+"""The agent interface shared by every planner run in the simulator."""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from anyplan.prediction.base import ObstacleObservation
+from anyplan.registry import Registry
+from anyplan.world.robot import Command, RobotState
+from anyplan.world.scenario import Scenario
+
+__all__ = ["Observation", "Agent", "AGENTS", "make_agent"]
+
+
+@dataclass(frozen=True)
+class Observation:
+    """What the agent sees at one control step.
+
+    Attributes:
+        t: Simulation time [s].
+        robot: The robot's pose and twist.
+        obstacles: Moving obstacles currently observed (all of them, or only those within
+            ``robot.sensing_range``).
+    """
+
+    t: float
+    robot: RobotState
+    obstacles: tuple[ObstacleObservation, ...] = ()
+
+
+@dataclass
+class AgentStats:
+    """What an agent reports about its run; merged into ``result.json``.
+
+    Attributes:
+        planning_times_s: Wall-clock time [s] of each planning call.
+        replans: Number of replanning events after the first plan.
+        virtual_obstacles: Virtual static obstacles created, as dicts
+            ``{center: [x, y], side, created_at_s}``.
+        plans: Planned paths, as dicts ``{t: creation time [s], path: [[x, y], ...]}``.
+        extra: Further method-specific fields.
+    """
+
+    planning_times_s: list[float] = field(default_factory=list)
+    replans: int = 0
+    virtual_obstacles: list[dict[str, Any]] = field(default_factory=list)
+    plans: list[dict[str, Any]] = field(default_factory=list)
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+class Agent(abc.ABC):
+    """A method that commands the robot one control step at a time.
+
+    Subclasses implement :meth:`reset` and :meth:`act`. They must not read the moving
+    obstacles of the scenario passed to :meth:`reset` (it has none: the simulator passes
+    :meth:`Scenario.static_only`); moving obstacles are known only through observations.
+    """
+
+    #: Registry name, set by subclasses.
+    name: str = "agent"
+
+    def __init__(self) -> None:
+        self.stats = AgentStats()
+
+    @abc.abstractmethod
+    def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
+        """Prepare for a run on ``scenario`` (static obstacles only), with its own ``rng``."""
+
+    @abc.abstractmethod
+    def act(self, obs: Observation) -> Command:
+        """The command for the next control period."""
+
+
+AGENTS: Registry[type[Agent]] = Registry("planner")
+AGENTS.register("straight", "anyplan.agents.straight:StraightAgent")
+AGENTS.register("bitstar", "anyplan.agents.bitstar:BITStarAgent")
+AGENTS.register("seq-bitstar", "anyplan.agents.sequential:SequentialBITStarAgent")
+AGENTS.register("dovs", "anyplan.agents.dovs:DOVSAgent")
+
+
+def make_agent(name: str, **config: Any) -> Agent:
+    """Instantiate the agent registered as ``name`` with keyword ``config``."""
+    cls = AGENTS.get(name)
+    return cls(**config)

@@ -1,0 +1,68 @@
+"""``anyplan``: argument parsing only; every command calls library functions.
+
+Each sub-command lives in its own module listed in :data:`COMMAND_MODULES`; a module provides
+``register(subparsers)`` which adds its parser and sets ``func`` (``args -> int``) as default.
+
+Bad input (an unknown scenario or planner, a malformed scenario file, a bad option value) ends
+with exit code 2 and one line on stderr, ``anyplan: error: ...``, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import logging
+import sys
+from collections.abc import Sequence
+
+from anyplan import __version__
+from anyplan.errors import AnyplanError
+
+__all__ = ["main", "COMMAND_MODULES", "UsageError"]
+
+#: Modules that each register one or more sub-commands.
+COMMAND_MODULES = [
+    "anyplan.cli.cmd_run",
+]
+
+
+class UsageError(AnyplanError):
+    """Bad command-line input detected after parsing (exit code 2)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line and exit with code 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        sys.stderr.write(f"anyplan: error: {self.prog}: {message}\n")
+        sys.exit(2)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full argument parser."""
+    parser = _Parser(prog="anyplan", description="Motion planning among static and moving "
+                     "obstacles: Sequential BIT*, BIT*, DOVS and friends.")
+    parser.add_argument("--version", action="version", version=f"anyplan {__version__}")
+    parser.add_argument("-v", "--verbose", action="count", default=0,
+                        help="more log output (repeat for debug)")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for mod in COMMAND_MODULES:
+        importlib.import_module(mod).register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit code (0 success, 1 failure, 2 bad input)."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.WARNING - 10 * min(args.verbose, 2),
+                        format="%(levelname)s %(name)s: %(message)s")
+    try:
+        return int(args.func(args))
+    except AnyplanError as exc:
+        sys.stderr.write(f"anyplan: error: {exc}\n")
+        return 2
+    except KeyboardInterrupt:
+        sys.stderr.write("anyplan: interrupted\n")
+        return 130

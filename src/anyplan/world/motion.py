@@ -1,0 +1,135 @@
+"""Motions of moving obstacles: positions as functions of time [s].
+
+A moving obstacle follows its motion whatever is in its way (it is not reactive).
+
+* :class:`UnicycleMotion`: constant speed v [m/s] and turn rate omega [rad/s] from a start
+  pose; a straight line if omega == 0, otherwise a circle of radius |v / omega|.
+  Straight: ``(x0 + v t cos th0, y0 + v t sin th0)``. Circular:
+  ``(x0 + v/w (sin(th0 + w t) - sin th0), y0 - v/w (cos(th0 + w t) - cos th0))``.
+  Before ``start_time`` the obstacle waits at its start pose; ``t`` above is measured from it.
+* :class:`WaypointMotion`: a looping, time-stamped, piecewise-linear track (DynaBARN).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Motion", "UnicycleMotion", "WaypointMotion"]
+
+
+class Motion:
+    """Base class: the trajectory of a point over time."""
+
+    #: Upper bound on the speed [m/s], used by certified contact tests.
+    max_speed: float = 0.0
+
+    def positions(self, t: np.ndarray) -> np.ndarray:
+        """Positions at times ``t`` (N,) [s], shape (N, 2) [m]."""
+        raise NotImplementedError
+
+    def position(self, t: float) -> np.ndarray:
+        """Position at time ``t`` [s], shape (2,) [m]."""
+        return self.positions(np.array([float(t)]))[0]
+
+    def state(self, t: float) -> tuple[float, float, float, float, float]:
+        """(x [m], y [m], heading [rad], v [m/s], omega [rad/s]) at time ``t`` [s]."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class UnicycleMotion(Motion):
+    """Constant (v, omega) motion from pose (x0, y0, theta0), starting at ``start_time``."""
+
+    x0: float
+    y0: float
+    theta0: float
+    v: float
+    omega: float = 0.0
+    start_time: float = 0.0
+
+    @property
+    def max_speed(self) -> float:  # type: ignore[override]
+        return abs(self.v)
+
+    @property
+    def is_straight(self) -> bool:
+        """True if the motion is a straight line (omega == 0)."""
+        return self.omega == 0.0
+
+    def positions(self, t: np.ndarray) -> np.ndarray:
+        tau = np.maximum(np.asarray(t, dtype=float) - self.start_time, 0.0)
+        if self.omega == 0.0:
+            x = self.x0 + self.v * tau * math.cos(self.theta0)
+            y = self.y0 + self.v * tau * math.sin(self.theta0)
+        else:
+            r = self.v / self.omega
+            th = self.theta0 + self.omega * tau
+            x = self.x0 + r * (np.sin(th) - math.sin(self.theta0))
+            y = self.y0 - r * (np.cos(th) - math.cos(self.theta0))
+        return np.column_stack([np.atleast_1d(x), np.atleast_1d(y)])
+
+    def state(self, t: float) -> tuple[float, float, float, float, float]:
+        moving = t >= self.start_time
+        tau = max(t - self.start_time, 0.0)
+        x, y = self.position(t)
+        th = self.theta0 + self.omega * tau
+        return (float(x), float(y), float(th), self.v if moving else 0.0,
+                self.omega if moving else 0.0)
+
+    @property
+    def circle_center(self) -> np.ndarray | None:
+        """Centre of the circular path [m], or None for a straight motion."""
+        if self.omega == 0.0:
+            return None
+        r = self.v / self.omega
+        return np.array([self.x0 - r * math.sin(self.theta0), self.y0 + r * math.cos(self.theta0)])
+
+
+@dataclass(frozen=True)
+class WaypointMotion(Motion):
+    """A looping piecewise-linear track: ``keyframes`` rows (t [s], x [m], y [m]).
+
+    The first keyframe time is 0 and the last is ``period``; the position at time t is the
+    linear interpolation at ``t mod period`` (a closed track repeats its first point at the end,
+    an open one jumps back, as in DynaBARN's Gazebo animations).
+    """
+
+    keyframes: np.ndarray
+
+    def __post_init__(self) -> None:
+        k = np.asarray(self.keyframes, dtype=float)
+        if k.ndim != 2 or k.shape[1] != 3 or len(k) < 2:
+            raise ValueError("keyframes must have shape (N >= 2, 3) as rows (t, x, y)")
+        if abs(k[0, 0]) > 1e-12 or np.any(np.diff(k[:, 0]) <= 0.0):
+            raise ValueError("keyframe times must start at 0 and increase strictly")
+        k.setflags(write=False)
+        object.__setattr__(self, "keyframes", k)
+
+    @property
+    def period(self) -> float:
+        """Loop period [s]."""
+        return float(self.keyframes[-1, 0])
+
+    @property
+    def max_speed(self) -> float:  # type: ignore[override]
+        k = self.keyframes
+        seg = np.hypot(np.diff(k[:, 1]), np.diff(k[:, 2])) / np.diff(k[:, 0])
+        return float(seg.max())
+
+    def positions(self, t: np.ndarray) -> np.ndarray:
+        tm = np.mod(np.asarray(t, dtype=float), self.period)
+        k = self.keyframes
+        return np.column_stack([np.interp(tm, k[:, 0], k[:, 1]), np.interp(tm, k[:, 0], k[:, 2])])
+
+    def state(self, t: float) -> tuple[float, float, float, float, float]:
+        tm = float(np.mod(t, self.period))
+        k = self.keyframes
+        i = int(np.clip(np.searchsorted(k[:, 0], tm, side="right") - 1, 0, len(k) - 2))
+        dt = k[i + 1, 0] - k[i, 0]
+        vx = (k[i + 1, 1] - k[i, 1]) / dt
+        vy = (k[i + 1, 2] - k[i, 2]) / dt
+        x, y = self.position(t)
+        return float(x), float(y), math.atan2(vy, vx), math.hypot(vx, vy), 0.0
