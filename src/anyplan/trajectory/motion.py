@@ -1,0 +1,218 @@
+"""From a planned polyline to a timed reference motion: :func:`plan_motion`.
+
+The chain of the paper (§4): smooth the path with a cubic spline, repair it where it cuts an
+obstacle, generate the reference motion within the robot's limits, and, when the robot must take
+up a path whose direction differs from its heading, turn in place first. Candidates:
+
+* ``smooth``: drive off along a spline that starts with the robot's heading and speed;
+* ``turn+smooth`` (only if the heading differs): brake to rest if moving, turn in place toward
+  the path (:mod:`anyplan.trajectory.turn`), then drive a spline tangent to the first segment;
+* ``polyline`` (fallback when no spline can be certified collision-free): brake if moving, then
+  for each segment turn in place and drive straight from rest to rest.
+
+The fastest candidate that is collision-free (certified, see :mod:`anyplan.trajectory.spline`)
+and feasible from the current state wins, so the robot turns in place only when that beats the
+smooth start.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
+from anyplan.geometry.se2 import wrap_angle
+from anyplan.trajectory.profile import time_lower_bound, time_parameterize
+from anyplan.trajectory.spline import SmoothCurve, clean_path, smooth_path
+from anyplan.trajectory.trajectory import (
+    BrakeSegment,
+    CurveSegment,
+    Segment,
+    Trajectory,
+    TurnSegment,
+)
+from anyplan.trajectory.turn import rotation_profile
+from anyplan.world.robot import RobotSpec, RobotState
+
+__all__ = ["plan_motion", "turn_segment", "polyline_trajectory"]
+
+_EPS_V = 1e-6  # [m/s] speeds below this count as rest
+_EPS_TH = 1e-3  # [rad] headings closer than this count as aligned
+
+
+def turn_segment(x: float, y: float, theta: float, target: float, spec: RobotSpec, t0: float,
+                 omega0: float = 0.0) -> TurnSegment:
+    """The faster of the two in-place rotations from ``theta`` to ``target`` [rad]."""
+    d = float(wrap_angle(target - theta))
+    options = [d, d - 2.0 * math.pi if d > 0.0 else d + 2.0 * math.pi]
+    rots = [rotation_profile(theta, o, spec.omega_max, spec.alpha_max, omega0) for o in options]
+    best = min(rots, key=lambda r: r.duration)
+    return TurnSegment(x, y, best, t0)
+
+
+def _brake(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: float,
+           t0: float) -> tuple[BrakeSegment | None, bool]:
+    """The braking segment (None at rest) and whether it is certified free."""
+    if abs(state.v) <= _EPS_V:
+        return None, True
+    seg = BrakeSegment(state.x, state.y, state.theta, state.v, state.omega, spec.a_max,
+                       spec.alpha_max, t0)
+    pts = seg.path_points(0.0)
+    # Consecutive samples are <= v0 * 2 ms apart; the arc leaves its chord by far less than 1 um.
+    free = bool(np.all(obstacles.segments_clearance(pts[:-1], pts[1:]) >= radius + 1e-6 - COLLISION_EPS))
+    return seg, free
+
+
+def _continue_from(p_stop: np.ndarray, pts: np.ndarray, obstacles: ObstacleSet,
+                   radius: float) -> np.ndarray:
+    """The path from ``p_stop`` (where the robot will be at rest): skip pts[0] if possible."""
+    if len(pts) >= 2 and obstacles.segment_free(p_stop, pts[1], radius) and \
+            math.hypot(*(pts[1] - p_stop)) > 1e-6:
+        return np.vstack([p_stop, pts[1:]])
+    if math.hypot(*(pts[0] - p_stop)) > 1e-6:
+        return np.vstack([p_stop, pts])
+    return pts
+
+
+def polyline_trajectory(path: np.ndarray, spec: RobotSpec, state: RobotState, t_start: float,
+                        obstacles: ObstacleSet | None = None, radius: float | None = None,
+                        grid_step: float = 0.02) -> Trajectory:
+    """Brake if moving, then turn in place and drive straight, rest to rest, along each segment.
+
+    The path's first point is replaced by the robot's position (after braking).
+    """
+    r = spec.radius if radius is None else radius
+    obst = obstacles if obstacles is not None else ObstacleSet()
+    segs: list[Segment] = []
+    t = t_start
+    brake, _ = _brake(state, spec, obst, r, t)
+    x, y, th, w = state.x, state.y, state.theta, state.omega
+    if brake is not None:
+        segs.append(brake)
+        t = brake.t1
+        x, y, th, _, _ = (float(v) for v in brake.sample(np.array([t])))
+        x, y, th = float(x), float(y), float(th)
+        w = 0.0
+    pts = clean_path(path)
+    pts = _continue_from(np.array([x, y]), pts, obst, r) if len(pts) >= 2 else np.array([[x, y]])
+    length = 0.0
+    for a, b in zip(pts[:-1], pts[1:], strict=True):
+        target = math.atan2(b[1] - a[1], b[0] - a[0])
+        if abs(float(wrap_angle(target - th))) > 1e-9 or abs(w) > 0.0:
+            seg = turn_segment(a[0], a[1], th, target, spec, t, w)
+            if seg.t1 > seg.t0:
+                segs.append(seg)
+                t = seg.t1
+        th, w = target, 0.0
+        curve = SmoothCurve(np.array([a, b]), grid_step=grid_step)
+        prof = time_parameterize(curve, spec, 0.0)
+        cs = CurveSegment(curve, prof, t)
+        segs.append(cs)
+        length += curve.length
+        t = cs.t1
+    if not segs:
+        segs.append(TurnSegment(x, y, rotation_profile(th, 0.0, spec.omega_max, spec.alpha_max, 0.0), t))
+    return Trajectory(segs, kind="polyline", lower_bound_s=time_lower_bound(length, spec, abs(state.v)),
+                      polyline=pts)
+
+
+def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles: ObstacleSet,
+                t_start: float, *, margin: float = 0.0, grid_step: float = 0.02,
+                max_repair_rounds: int = 10, allow_turn: bool = True) -> Trajectory:
+    """Turn a planned polyline into a timed, collision-free reference motion.
+
+    Args:
+        path: Planned points (N, 2) [m] from (near) the robot's position to the goal. A first
+            point within 5 cm of the robot is moved onto it; otherwise the robot's position is
+            prepended.
+        spec: Robot limits and radius.
+        state: Current robot state (pose and twist).
+        obstacles: Obstacles the curve must avoid (static and any virtual ones).
+        t_start: Absolute time [s] at which the motion starts.
+        margin: Extra clearance [m] required of the smoothed curve beyond ``spec.radius``.
+        grid_step: Grid spacing [m] of the speed profile and the collision certification.
+        max_repair_rounds: Spline repair rounds before the polyline fallback.
+        allow_turn: Consider turning in place (disable to force the smooth start).
+
+    Returns:
+        The fastest admissible :class:`Trajectory`; ``info`` lists the candidate durations.
+    """
+    radius = spec.radius + margin
+    pts = clean_path(path)
+    p0 = np.array([state.x, state.y])
+    d0 = math.hypot(*(pts[0] - p0))
+    if d0 <= 0.05:
+        pts = pts.copy()
+        pts[0] = p0
+        if len(pts) >= 2 and math.hypot(*(pts[1] - p0)) <= 1e-9:
+            pts = pts[1:]
+    else:
+        pts = np.vstack([p0, pts])
+    if len(pts) < 2:
+        # Nothing to drive: brake (if moving) and stay.
+        brake, _ = _brake(state, spec, obstacles, radius, t_start)
+        seg: Segment = brake if brake is not None else TurnSegment(
+            state.x, state.y, rotation_profile(state.theta, 0.0, spec.omega_max, spec.alpha_max,
+                                               state.omega), t_start)
+        return Trajectory([seg], kind="hold", lower_bound_s=0.0, polyline=pts)
+    v0 = max(state.v, 0.0)
+    cands: list[tuple[bool, float, Trajectory]] = []
+    info: dict = {"candidates": {}}
+
+    # A. smooth start along the current heading, at the current speed.
+    res = smooth_path(pts, obstacles, radius, start_heading=state.theta, max_rounds=max_repair_rounds,
+                      grid_step=grid_step)
+    if res.curve is not None:
+        prof = time_parameterize(res.curve, spec, v0)
+        seg_a = CurveSegment(res.curve, prof, t_start)
+        tr = Trajectory([seg_a], kind="smooth", feasible=prof.feasible,
+                        lower_bound_s=time_lower_bound(res.curve.length, spec, v0), polyline=pts,
+                        info={"repair_rounds": res.rounds, "points_added": res.points_added,
+                              "certified_margin_m": res.margin})
+        cands.append((prof.feasible, tr.duration, tr))
+        info["candidates"]["smooth"] = tr.duration if prof.feasible else math.inf
+
+    # B. brake (if moving), turn in place toward the path, then a spline tangent to it.
+    first_dir = math.atan2(pts[1][1] - pts[0][1], pts[1][0] - pts[0][0])
+    misaligned = abs(float(wrap_angle(first_dir - state.theta))) > _EPS_TH
+    if allow_turn and (misaligned or res.curve is None or not cands[-1][0]):
+        segs: list[Segment] = []
+        t = t_start
+        brake, brake_free = _brake(state, spec, obstacles, radius, t)
+        x, y, th, w = state.x, state.y, state.theta, state.omega
+        if brake is not None:
+            segs.append(brake)
+            t = brake.t1
+            bx, by, bth, _, _ = brake.sample(np.array([t]))
+            x, y, th, w = float(bx[0]), float(by[0]), float(bth[0]), 0.0
+        pts_b = _continue_from(np.array([x, y]), pts, obstacles, radius)
+        target = math.atan2(pts_b[1][1] - pts_b[0][1], pts_b[1][0] - pts_b[0][0])
+        turn = turn_segment(x, y, th, target, spec, t, w)
+        if turn.t1 > turn.t0:
+            segs.append(turn)
+            t = turn.t1
+        res_b = smooth_path(pts_b, obstacles, radius, start_heading=target,
+                            max_rounds=max_repair_rounds, grid_step=grid_step)
+        if res_b.curve is not None and brake_free:
+            prof = time_parameterize(res_b.curve, spec, 0.0)
+            segs.append(CurveSegment(res_b.curve, prof, t))
+            tr = Trajectory(segs, kind="turn+smooth" if brake is None else "brake+turn+smooth",
+                            feasible=True,
+                            lower_bound_s=time_lower_bound(res_b.curve.length, spec, 0.0),
+                            polyline=pts_b,
+                            info={"repair_rounds": res_b.rounds, "points_added": res_b.points_added,
+                                  "certified_margin_m": res_b.margin})
+            cands.append((True, tr.duration, tr))
+            info["candidates"]["turn+smooth"] = tr.duration
+
+    if not any(ok for ok, _, _ in cands):
+        tr = polyline_trajectory(pts, spec, state, t_start, obstacles, radius, grid_step)
+        cands.append((True, tr.duration, tr))
+        info["candidates"]["polyline"] = tr.duration
+
+    feasible = [c for c in cands if c[0]]
+    pool = feasible if feasible else cands
+    best = min(pool, key=lambda c: c[1])[2]
+    best.info.update(info)
+    return best

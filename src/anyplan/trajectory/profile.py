@@ -1,0 +1,188 @@
+"""Time-optimal speed profile along a fixed curve under the robot's limits (forward/backward passes).
+
+The limits of a differential-drive robot moving along a curve with curvature kappa(s):
+
+* speed: ``v <= v_max``;
+* turn rate: ``|omega| = v |kappa| <= omega_max``;
+* linear acceleration: ``|dv/dt| <= a_max``;
+* angular acceleration: ``|d omega/dt| = |kappa' v^2 + kappa dv/dt| <= alpha_max``
+  (kappa' = dkappa/ds).
+
+With x = v^2 as the state, dx/ds = 2 dv/dt. The profile is piecewise *constant acceleration*:
+x is linear in s on each grid interval [s_i, s_{i+1}] with slope d_i = 2 a_i. On an interval,
+let K_i and K'_i bound |kappa| and |kappa'| (dense sub-samples, inflated). Then for every s in
+the interval, not only at the grid points,
+
+* v(s) <= v_max and v |kappa| <= omega_max hold if x_i and x_{i+1} are both below
+  ``min(v_max^2, (omega_max / K_i)^2)`` (x is linear, so its maximum is at an end);
+* |dv/dt| = |d_i| / 2 <= a_max;
+* |d omega/dt| <= K'_i max(x_i, x_{i+1}) + K_i |d_i| / 2 <= alpha_max.
+
+This is the classic numerical integration scheme for time-optimal path parameterisation
+(Bobrow, Dubowsky & Gibson 1985; Shin & McKay 1985; Pham 2014 "A general, fast, and robust
+implementation of the time-optimal path parameterization algorithm"): a maximum velocity curve,
+a backward pass that brakes as late as possible from the goal at rest, then a forward pass that
+accelerates as hard as possible from the current speed, each clipped by the other. The
+alpha-constraint couples a and v; with the interval bounds above both passes remain exact
+minimisers of the grid-constrained problem, and the final profile satisfies every interval
+constraint (proof in the comments of :func:`time_parameterize`).
+
+The time lower bound (:func:`time_lower_bound`) ignores curvature: length / v_max plus the time
+lost accelerating from the current speed and braking to rest at a_max.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from anyplan.trajectory.spline import SmoothCurve
+from anyplan.world.robot import RobotSpec
+
+__all__ = ["SpeedProfile", "time_parameterize", "time_lower_bound"]
+
+#: Relative inflation of the sampled curvature bounds on each grid interval.
+KAPPA_INFLATION = 1.02
+#: Sub-samples per grid interval used to bound |kappa| and |kappa'|.
+SUBSAMPLES = 6
+
+
+@dataclass
+class SpeedProfile:
+    """Speed along a curve: piecewise constant acceleration on the grid ``s``.
+
+    Attributes:
+        s: Arc-length grid [m] (M,).
+        u: Curve parameter at the grid (M,).
+        v: Speed [m/s] at the grid (M,), v[-1] == 0.
+        t: Time [s] since the start of the profile at the grid (M,).
+        kappa_max: Bound on |kappa| [1/m] on each interval (M-1,).
+        dkappa_max: Bound on |dkappa/ds| [1/m^2] on each interval (M-1,).
+        feasible: False if the requested start speed was above what the curve allows (the
+            profile then starts from the highest admissible speed instead).
+        v_start_requested: The requested start speed [m/s].
+    """
+
+    s: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    t: np.ndarray
+    kappa_max: np.ndarray
+    dkappa_max: np.ndarray
+    feasible: bool
+    v_start_requested: float
+
+    @property
+    def duration(self) -> float:
+        """Total time [s]."""
+        return float(self.t[-1])
+
+    @property
+    def accel(self) -> np.ndarray:
+        """Constant acceleration [m/s^2] on each interval (M-1,)."""
+        return (self.v[1:] ** 2 - self.v[:-1] ** 2) / (2.0 * np.diff(self.s))
+
+    def at_time(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(s [m], v [m/s], a [m/s^2]) at times ``tau`` [s] since the profile's start (clamped)."""
+        tau = np.clip(np.asarray(tau, dtype=float), 0.0, self.t[-1])
+        i = np.clip(np.searchsorted(self.t, tau, side="right") - 1, 0, len(self.t) - 2)
+        a = self.accel[i]
+        dt = tau - self.t[i]
+        v = np.maximum(self.v[i] + a * dt, 0.0)
+        s = np.minimum(self.s[i] + self.v[i] * dt + 0.5 * a * dt * dt, self.s[i + 1])
+        return s, v, a
+
+
+def _interval_bounds(curve: SmoothCurve, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Bounds on |kappa| and |kappa'| over each interval [u_i, u_{i+1}] (never across a knot)."""
+    fr = np.linspace(0.0, 1.0, SUBSAMPLES + 1)
+    # keep the right end inside the same cubic piece: kappa' jumps at the knots
+    fr[-1] = 1.0 - 1e-9
+    fr[0] = 1e-9
+    uu = u[:-1, None] + np.diff(u)[:, None] * fr[None, :]
+    k, dk = curve.curvature(uu.ravel())
+    k = np.abs(k).reshape(uu.shape).max(axis=1)
+    dk = np.abs(dk).reshape(uu.shape).max(axis=1)
+    # Endpoint values, exactly at the grid points, also count (kappa is continuous).
+    ke, _ = curve.curvature(u)
+    k = np.maximum(k, np.maximum(np.abs(ke[:-1]), np.abs(ke[1:])))
+    return k * KAPPA_INFLATION + 1e-9, dk * KAPPA_INFLATION + 1e-9
+
+
+def time_parameterize(curve: SmoothCurve, spec: RobotSpec, v_start: float = 0.0) -> SpeedProfile:
+    """Time-optimal (on the grid) speed profile from ``v_start`` to rest at the curve's end.
+
+    Args:
+        curve: The geometric path.
+        spec: Robot limits (v_max, omega_max, a_max, alpha_max).
+        v_start: Current forward speed [m/s] (negative values are treated as 0).
+
+    Returns:
+        A :class:`SpeedProfile` that satisfies all four limits everywhere along the curve.
+    """
+    s, u = curve.s_grid, curve.u_grid
+    ds = np.diff(s)
+    kmax, dkmax = _interval_bounds(curve, u)
+    a2, al = 2.0 * spec.a_max, spec.alpha_max
+    # Maximum velocity curve (in x = v^2) per interval, then per node (min of both sides).
+    xi = np.minimum(spec.v_max ** 2, (spec.omega_max / kmax) ** 2)
+    xi = np.minimum(xi, al / dkmax)
+    mvc = np.empty(len(s))
+    mvc[0] = xi[0]
+    mvc[-1] = xi[-1]
+    mvc[1:-1] = np.minimum(xi[:-1], xi[1:])
+
+    def step(x_from: float, i: int) -> float:
+        # Largest |d| on interval i from the lower end value x_from, moving up to
+        # x_from + |d| ds: K' (x_from + |d| ds) + K |d| / 2 <= alpha and |d| <= 2 a.
+        num = al - dkmax[i] * x_from
+        if num <= 0.0:
+            return 0.0
+        return min(a2, num / (dkmax[i] * ds[i] + 0.5 * kmax[i]))
+
+    n = len(s)
+    back = np.empty(n)
+    back[-1] = 0.0
+    for i in range(n - 2, -1, -1):
+        # Braking into node i+1 from node i: x_i = x_{i+1} + |d| ds, the interval maximum is x_i.
+        back[i] = min(mvc[i], back[i + 1] + step(back[i + 1], i) * ds[i])
+    v0 = max(float(v_start), 0.0)
+    x = np.empty(n)
+    feasible = v0 * v0 <= back[0] * (1.0 + 1e-9) + 1e-12
+    x[0] = min(v0 * v0, back[0])
+    for i in range(n - 1):
+        # Accelerating from x_i: if the result is clipped by back[i+1] < x_i the braking step is
+        # feasible because back[i] >= x_i was built from back[i+1] with the largest admissible
+        # |d|, and the constraint is monotone in both x_i and |d|.
+        x[i + 1] = min(back[i + 1], x[i] + step(x[i], i) * ds[i])
+    v = np.sqrt(np.maximum(x, 0.0))
+    vs = v[:-1] + v[1:]
+    with np.errstate(divide="ignore"):
+        dt = np.where(vs > 0.0, 2.0 * ds / np.where(vs > 0.0, vs, 1.0), np.inf)
+    t = np.concatenate([[0.0], np.cumsum(dt)])
+    return SpeedProfile(s=s.copy(), u=u.copy(), v=v, t=t, kappa_max=kmax, dkappa_max=dkmax,
+                        feasible=bool(feasible), v_start_requested=float(v_start))
+
+
+def time_lower_bound(length: float, spec: RobotSpec, v_start: float = 0.0) -> float:
+    """Least time [s] to cover ``length`` [m] from speed ``v_start`` to rest, ignoring curvature.
+
+    Trapezoidal (or triangular) speed under v_max and a_max. For a path long enough to reach
+    v_max from rest this is ``length / v_max + v_max / a_max``.
+    """
+    if length <= 0.0:
+        return 0.0
+    a, vm = spec.a_max, spec.v_max
+    v0 = min(max(v_start, 0.0), vm)
+    d_acc = (vm * vm - v0 * v0) / (2.0 * a)
+    d_dec = vm * vm / (2.0 * a)
+    if d_acc + d_dec <= length:
+        return (vm - v0) / a + (length - d_acc - d_dec) / vm + vm / a
+    # Triangle: peak vp with (vp^2 - v0^2) / 2a + vp^2 / 2a = length.
+    vp2 = a * length + 0.5 * v0 * v0
+    if vp2 < v0 * v0:  # cannot stop in time: the bound is the braking time itself
+        return v0 / a
+    vp = math.sqrt(vp2)
+    return (vp - v0) / a + vp / a

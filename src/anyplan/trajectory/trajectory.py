@@ -1,0 +1,242 @@
+"""The reference motion of the robot over absolute time: a sequence of timed segments.
+
+A :class:`Trajectory` is what the tracking controller follows and what Sequential BIT* uses to
+predict, continuously in time, whether the robot will meet a moving obstacle. Its segments are
+
+* :class:`CurveSegment`: driving along a :class:`~anyplan.trajectory.spline.SmoothCurve` with a
+  :class:`~anyplan.trajectory.profile.SpeedProfile`;
+* :class:`TurnSegment`: turning in place (:mod:`anyplan.trajectory.turn`);
+* :class:`BrakeSegment`: braking to rest from the current twist (v and omega decelerated at
+  a_max and alpha_max), integrated finely (error < 1e-6 m).
+
+Times are absolute simulation times [s]. Before ``t_start`` the trajectory is held at its start
+state, after ``t_end`` at its end pose with zero twist.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from anyplan.trajectory.profile import SpeedProfile
+from anyplan.trajectory.spline import SmoothCurve
+from anyplan.trajectory.turn import RotationProfile
+
+__all__ = ["Segment", "CurveSegment", "TurnSegment", "BrakeSegment", "Trajectory"]
+
+Sample = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+class Segment:
+    """A piece of reference motion on [t0, t1] (absolute times [s])."""
+
+    t0: float
+    t1: float
+    #: Bound on the speed of the reference position [m/s].
+    max_speed: float = 0.0
+    #: Distance driven [m].
+    length: float = 0.0
+
+    def sample(self, t: np.ndarray) -> Sample:
+        """(x, y, theta, v, omega) at times ``t`` (clamped to the segment)."""
+        raise NotImplementedError
+
+    def path_points(self, step: float) -> np.ndarray:
+        """Geometric points (M, 2) [m] visited by the segment."""
+        raise NotImplementedError
+
+
+class CurveSegment(Segment):
+    """Driving along ``curve`` with ``profile``, starting at absolute time ``t0`` [s]."""
+
+    kind = "curve"
+
+    def __init__(self, curve: SmoothCurve, profile: SpeedProfile, t0: float) -> None:
+        self.curve, self.profile = curve, profile
+        self.t0 = float(t0)
+        self.t1 = self.t0 + profile.duration
+        self.length = curve.length
+        u, s = profile.u, profile.s
+        mid = 0.5 * (u[:-1] + u[1:])
+        sp = np.maximum.reduce([np.hypot(*curve.derivatives(x)[0].T) for x in (u[:-1], mid, u[1:])])
+        stretch = sp * np.diff(u) / np.diff(s)
+        vmax = np.maximum(profile.v[:-1], profile.v[1:])
+        self.max_speed = float(np.max(stretch * vmax)) * 1.001 if len(vmax) else 0.0
+
+    def sample(self, t: np.ndarray) -> Sample:
+        s, v, _ = self.profile.at_time(np.asarray(t, dtype=float) - self.t0)
+        u = self.curve.u_of_s(s)
+        p = self.curve.position(u)
+        th = self.curve.heading(u)
+        kappa, _ = self.curve.curvature(u)
+        return p[:, 0], p[:, 1], th, v, kappa * v
+
+    def path_points(self, step: float) -> np.ndarray:
+        return self.curve.samples(step)
+
+
+class TurnSegment(Segment):
+    """Turning in place at (x, y) [m] following ``rotation``, from absolute time ``t0`` [s]."""
+
+    kind = "turn"
+
+    def __init__(self, x: float, y: float, rotation: RotationProfile, t0: float) -> None:
+        self.x, self.y, self.rotation = float(x), float(y), rotation
+        self.t0 = float(t0)
+        self.t1 = self.t0 + rotation.duration
+        self.max_speed = 0.0
+        self.length = 0.0
+
+    def sample(self, t: np.ndarray) -> Sample:
+        t = np.asarray(t, dtype=float)
+        th, w = self.rotation.at_time(t - self.t0)
+        return (np.full(t.shape, self.x), np.full(t.shape, self.y), th, np.zeros(t.shape), w)
+
+    def path_points(self, step: float) -> np.ndarray:
+        return np.array([[self.x, self.y]])
+
+
+class BrakeSegment(Segment):
+    """Braking to rest: v and omega go to zero at a_max and alpha_max, from time ``t0`` [s]."""
+
+    kind = "brake"
+
+    def __init__(self, x: float, y: float, theta: float, v0: float, omega0: float, a_max: float,
+                 alpha_max: float, t0: float, dt: float = 0.002) -> None:
+        self.v0, self.w0, self.a, self.al = float(v0), float(omega0), a_max, alpha_max
+        self.theta0 = float(theta)
+        self.t0 = float(t0)
+        dur = max(abs(v0) / a_max, abs(omega0) / alpha_max)
+        self.t1 = self.t0 + dur
+        n = max(2, math.ceil(dur / dt) + 1)
+        self._tau = np.linspace(0.0, dur, n)
+        _, _, th, v, _ = self._twist(self._tau)
+        # Midpoint-of-interval integration with the exact heading: error O(dt^2 * v * omega).
+        tm = 0.5 * (self._tau[:-1] + self._tau[1:])
+        _, _, thm, vm, _ = self._twist(tm)
+        h = np.diff(self._tau)
+        self._x = x + np.concatenate([[0.0], np.cumsum(vm * np.cos(thm) * h)])
+        self._y = y + np.concatenate([[0.0], np.cumsum(vm * np.sin(thm) * h)])
+        self.max_speed = abs(self.v0) * 1.001
+        self.length = float(np.sum(np.abs(vm) * h))
+
+    def _twist(self, tau: np.ndarray) -> Sample:
+        tau = np.asarray(tau, dtype=float)
+        tv = abs(self.v0) / self.a
+        tw = abs(self.w0) / self.al
+        sv = math.copysign(self.a, self.v0)
+        sw = math.copysign(self.al, self.w0)
+        cv, cw = np.minimum(tau, tv), np.minimum(tau, tw)
+        v = self.v0 - sv * cv
+        w = self.w0 - sw * cw
+        th = self.theta0 + self.w0 * cw - 0.5 * sw * cw * cw
+        z = np.zeros(tau.shape)
+        return z, z, th, v, w
+
+    def sample(self, t: np.ndarray) -> Sample:
+        tau = np.clip(np.asarray(t, dtype=float) - self.t0, 0.0, self.t1 - self.t0)
+        _, _, th, v, w = self._twist(tau)
+        return np.interp(tau, self._tau, self._x), np.interp(tau, self._tau, self._y), th, v, w
+
+    def path_points(self, step: float) -> np.ndarray:
+        return np.column_stack([self._x, self._y])
+
+
+class Trajectory:
+    """A reference motion over absolute time [s]: consecutive segments.
+
+    Attributes:
+        segments: The segments, contiguous in time.
+        kind: How it was built (``"smooth"``, ``"turn+smooth"``, ``"polyline"``, ...).
+        feasible: False when the robot's current state could not be followed within its limits
+            (the trajectory is then a best effort).
+        lower_bound_s: Time lower bound [s] for driving :attr:`length` from the start speed to
+            rest under v_max and a_max only (no curvature, no turning).
+        polyline: The input path after cleaning (N, 2) [m].
+        info: Diagnostics (repair rounds, candidate times, ...).
+    """
+
+    def __init__(self, segments: Sequence[Segment], kind: str = "smooth", feasible: bool = True,
+                 lower_bound_s: float = float("nan"), polyline: np.ndarray | None = None,
+                 info: dict | None = None) -> None:
+        if not segments:
+            raise ValueError("a trajectory needs at least one segment")
+        self.segments = list(segments)
+        self.kind = kind
+        self.feasible = feasible
+        self.lower_bound_s = lower_bound_s
+        self.polyline = polyline
+        self.info = dict(info or {})
+        self._starts = np.array([s.t0 for s in self.segments])
+        pts = [s.path_points(0.05) for s in self.segments]
+        path = np.vstack(pts)
+        keep = np.concatenate([[True], np.hypot(*np.diff(path, axis=0).T) > 1e-12])
+        self._path = path[keep]
+
+    @property
+    def t_start(self) -> float:
+        """Absolute start time [s]."""
+        return self.segments[0].t0
+
+    @property
+    def t_end(self) -> float:
+        """Absolute time [s] at which the robot is at rest at the end of the path."""
+        return self.segments[-1].t1
+
+    @property
+    def duration(self) -> float:
+        """t_end - t_start [s]."""
+        return self.t_end - self.t_start
+
+    @property
+    def max_speed(self) -> float:
+        """Upper bound on |d position / dt| [m/s] over all time (for certified contact tests)."""
+        return max(s.max_speed for s in self.segments)
+
+    @property
+    def length(self) -> float:
+        """Distance driven along the path [m]."""
+        return float(sum(s.length for s in self.segments))
+
+    @property
+    def path(self) -> np.ndarray:
+        """The geometric curve followed, as points (M, 2) [m] about 5 cm apart."""
+        return self._path
+
+    def sample(self, t: np.ndarray | float) -> Sample:
+        """Reference state at absolute times ``t`` [s].
+
+        Returns:
+            Arrays x [m], y [m], theta [rad], v [m/s], omega [rad/s] of the shape of ``t``.
+        """
+        t = np.asarray(t, dtype=float)
+        flat = t.ravel()
+        out = [np.empty(flat.shape) for _ in range(5)]
+        idx = np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0, len(self.segments) - 1)
+        for k in np.unique(idx):
+            m = idx == k
+            vals = self.segments[k].sample(flat[m])
+            for o, val in zip(out, vals, strict=True):
+                o[m] = val
+        after = flat >= self.t_end
+        out[3][after] = 0.0
+        out[4][after] = 0.0
+        return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
+
+    def positions(self, t: np.ndarray | float) -> np.ndarray:
+        """Reference positions (N, 2) [m] at absolute times ``t`` (N,) [s]."""
+        x, y, _, _, _ = self.sample(np.atleast_1d(np.asarray(t, dtype=float)))
+        return np.column_stack([x.ravel(), y.ravel()])
+
+    def state(self, t: float) -> tuple[float, float, float, float, float]:
+        """(x, y, theta, v, omega) at absolute time ``t`` [s] as floats."""
+        vals = self.sample(np.array([float(t)]))
+        return tuple(float(v[0]) for v in vals)  # type: ignore[return-value]
+
+    @property
+    def end_pose(self) -> tuple[float, float, float]:
+        """(x [m], y [m], theta [rad]) at the end."""
+        x, y, th, _, _ = self.state(self.t_end)
+        return x, y, th
