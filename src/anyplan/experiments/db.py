@@ -1,0 +1,375 @@
+"""The results database: one SQLite file in the layout of OMPL's benchmark database.
+
+OMPL's ``ompl_benchmark_statistics.py`` (and so Planner Arena) reads a database of five tables;
+we write the same tables with the same required columns, and add our own columns where OMPL
+allows it (extra experiment properties, extra run properties, extra progress properties):
+
+* ``experiments``: one row per (scenario content, master seed, simulation settings). OMPL's
+  columns (``name`` = scenario name, ``version`` = ``"anyplan X.Y.Z"``, ``seed`` = master seed,
+  ``timelimit`` = simulated time limit [s], ``runcount`` = runs per planner, ``setup`` = the
+  scenario as JSON, so figures can be redrawn from the database alone) plus ``scenario_hash``,
+  ``moving_obstacles``, ``suite``, ``sim_dt``.
+* ``plannerConfigs``: ``name`` = registry name, ``settings`` = the agent's keyword config as
+  ``"key = value;"`` lines (OMPL's convention), empty for the defaults.
+* ``enums``: OMPL's ``status`` values 0-9 plus our value 10, ``Collision``.
+* ``runs``: OMPL's ``status``, ``solved``, ``time`` (total planning wall time [s]),
+  ``best_cost`` and ``solution_length`` (executed path length [m], NULL unless solved),
+  ``approximate_solution``, ``correct_solution``, ``memory``; plus ours (see ``RUN_COLUMNS``).
+* ``progress``: ``(runid, time, best_cost)`` as in OMPL, plus ``plan_index`` and ``source``:
+  ``source = 'planner'`` rows are an anytime planner's cost [m] against planning time [s] (from
+  ``result.extra["progress"] = [[time_s, cost_m], ...]``, OMPL's meaning); ``source = 'plans'``
+  rows are the executed plans' lengths [m] against the simulated time [s] they were made
+  (``result.plans``). OMPL's own rows (imported logs) have ``source`` NULL.
+
+And one table of our own, ``results(runid, encoding, data)``: the whole ``result.json`` of the
+run (trajectory, plans, virtual obstacles), zlib-compressed JSON.
+
+Only the coordinating process opens the database for writing; each finished run is committed in
+its own transaction, so an interruption loses no finished run.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import platform
+import sqlite3
+import zlib
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from anyplan import __version__
+
+__all__ = [
+    "ResultsDB",
+    "STATUS",
+    "STATUS_OF_OUTCOME",
+    "RUN_COLUMNS",
+    "settings_string",
+    "run_row",
+    "progress_rows",
+]
+
+SCHEMA_VERSION = "1"
+
+#: OMPL's PlannerStatus descriptions (values 0-9) and our Collision (10).
+STATUS: dict[int, str] = {
+    0: "Unknown status", 1: "Invalid start", 2: "Invalid goal", 3: "Unrecognized goal type",
+    4: "Timeout", 5: "Approximate solution", 6: "Exact solution", 7: "Crash", 8: "Abort",
+    9: "Infeasible", 10: "Collision",
+}
+#: Our run outcome -> status value. ``error`` (the planner raised) is OMPL's "Crash".
+STATUS_OF_OUTCOME = {"reached": 6, "timeout": 4, "collision": 10, "error": 7}
+
+#: Run columns beyond experimentid/plannerid: (name, SQL type). OMPL's first, then ours.
+RUN_COLUMNS: list[tuple[str, str]] = [
+    ("status", "ENUM"), ("solved", "BOOLEAN"), ("approximate_solution", "BOOLEAN"),
+    ("correct_solution", "BOOLEAN"), ("time", "REAL"), ("best_cost", "REAL"),
+    ("solution_length", "REAL"), ("memory", "REAL"),
+    ("run_index", "INTEGER"), ("seed", "INTEGER"), ("scenario_hash", "TEXT"),
+    ("anyplan_version", "TEXT"), ("outcome", "TEXT"), ("reached", "BOOLEAN"), ("collided", "BOOLEAN"),
+    ("path_length", "REAL"), ("time_to_goal", "REAL"), ("sim_time", "REAL"),
+    ("planning_calls", "INTEGER"), ("planning_time_first", "REAL"), ("planning_time_mean", "REAL"),
+    ("planning_time_p95", "REAL"), ("planning_time_max", "REAL"), ("planning_time_total", "REAL"),
+    ("replans", "INTEGER"), ("virtual_obstacles", "INTEGER"), ("plans", "INTEGER"),
+    ("min_clearance", "REAL"), ("collision_with", "TEXT"), ("collision_time", "REAL"),
+    ("wall_time", "REAL"), ("worker", "TEXT"), ("error", "TEXT"),
+]
+
+_EXPERIMENT_EXTRA = [("scenario_hash", "TEXT"), ("moving_obstacles", "INTEGER"), ("suite", "TEXT"),
+                     ("sim_dt", "REAL")]
+
+
+def settings_string(config: Mapping[str, Any]) -> str:
+    """OMPL-style planner settings: ``"key = value;"`` per entry, sorted; empty for {}."""
+    return "".join(f"{k} = {json.dumps(config[k], sort_keys=True)};" for k in sorted(config))
+
+
+def _fin(x: Any) -> float | None:
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def run_row(result: Mapping[str, Any] | None, *, run_index: int, seed: int, scenario_hash: str,
+            error: str | None = None, worker: str = "", wall_time: float | None = None) -> dict[str, Any]:
+    """The ``runs`` row of one run's ``result.json`` (or of a run whose planner raised)."""
+    if result is None:
+        return {"status": STATUS_OF_OUTCOME["error"], "solved": 0, "approximate_solution": 0,
+                "correct_solution": 0, "time": None, "best_cost": None, "solution_length": None,
+                "memory": None, "run_index": run_index, "seed": seed, "scenario_hash": scenario_hash,
+                "anyplan_version": __version__, "outcome": "error", "reached": 0, "collided": 0,
+                "wall_time": _fin(wall_time), "worker": worker, "error": error}
+    outcome = str(result.get("status", "timeout"))
+    reached = bool(result.get("reached_goal")) and outcome == "reached"
+    pts = np.asarray(result.get("planning_times_s") or [], dtype=float)
+    traj = result.get("trajectory") or [[0.0]]
+    length = _fin(result.get("path_length_m"))
+    return {
+        "status": STATUS_OF_OUTCOME.get(outcome, 0),
+        "solved": int(reached), "approximate_solution": 0, "correct_solution": int(reached),
+        "time": float(pts.sum()) if pts.size else 0.0,
+        "best_cost": length if reached else None, "solution_length": length if reached else None,
+        "memory": None,
+        "run_index": run_index, "seed": seed, "scenario_hash": scenario_hash,
+        "anyplan_version": str(result.get("anyplan_version", __version__)),
+        "outcome": outcome, "reached": int(reached), "collided": int(bool(result.get("collision"))),
+        "path_length": length, "time_to_goal": _fin(result.get("time_to_goal_s")),
+        "sim_time": _fin(traj[-1][0]),
+        "planning_calls": int(pts.size),
+        "planning_time_first": float(pts[0]) if pts.size else None,
+        "planning_time_mean": float(pts.mean()) if pts.size else None,
+        "planning_time_p95": float(np.percentile(pts, 95)) if pts.size else None,
+        "planning_time_max": float(pts.max()) if pts.size else None,
+        "planning_time_total": float(pts.sum()) if pts.size else 0.0,
+        "replans": int(result.get("replans") or 0),
+        "virtual_obstacles": len(result.get("virtual_obstacles") or []),
+        "plans": len(result.get("plans") or []),
+        "min_clearance": _fin(result.get("min_clearance_m")),
+        "collision_with": result.get("collision_with"),
+        "collision_time": _fin(result.get("collision_time_s")),
+        "wall_time": _fin(wall_time if wall_time is not None else result.get("wall_time_s")),
+        "worker": worker, "error": error,
+    }
+
+
+def _polyline_length(path: Any) -> float | None:
+    p = np.asarray(path, dtype=float)
+    if p.ndim != 2 or p.shape[0] < 2 or p.shape[1] < 2:
+        return None
+    return float(np.hypot(*np.diff(p[:, :2], axis=0).T).sum())
+
+
+def progress_rows(result: Mapping[str, Any]) -> list[tuple[float, float, int | None, str]]:
+    """``(time, best_cost, plan_index, source)`` rows of a run (see the module docstring).
+
+    An anytime planner's own history (``extra["progress"]``) is preferred; otherwise the lengths
+    of the executed plans against the simulated time they were made. Duplicate times keep the
+    last value (the table's key is ``(runid, time)``).
+    """
+    extra = result.get("extra") or {}
+    rows: dict[float, tuple[float, float, int | None, str]] = {}
+    hist = extra.get("progress") if isinstance(extra, Mapping) else None
+    if hist:
+        for item in hist:
+            try:
+                t, c = float(item[0]), float(item[1])
+            except (TypeError, ValueError, IndexError):
+                continue
+            if math.isfinite(t) and math.isfinite(c):
+                rows[t] = (t, c, None, "planner")
+        if rows:
+            return sorted(rows.values())
+    for i, plan in enumerate(result.get("plans") or []):
+        try:
+            t = float(plan["t"])
+        except (KeyError, TypeError, ValueError):
+            continue
+        c = _polyline_length(plan.get("path"))
+        if c is not None and math.isfinite(t):
+            rows[t] = (t, c, i, "plans")
+    return sorted(rows.values())
+
+
+@dataclass(frozen=True)
+class ExperimentKey:
+    """What identifies an experiment row: the scenario's content and the bench settings."""
+
+    name: str
+    scenario_hash: str
+    seed: int
+    sim_dt: float
+    timelimit: float
+
+
+class ResultsDB:
+    """Read and write a results database (see the module docstring).
+
+    Args:
+        path: The SQLite file; created with the schema if missing.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        self.conn = sqlite3.connect(str(self.path), timeout=30.0)
+        self.conn.execute("PRAGMA foreign_keys = ON")
+        self._create()
+
+    # ---------------------------------------------------------------- schema
+    def _create(self) -> None:
+        c = self.conn
+        c.executescript("""
+            CREATE TABLE IF NOT EXISTS experiments
+              (id INTEGER PRIMARY KEY AUTOINCREMENT, name VARCHAR(512), totaltime REAL,
+               timelimit REAL, memorylimit REAL, runcount INTEGER, version VARCHAR(128),
+               hostname VARCHAR(1024), cpuinfo TEXT, date DATETIME, seed VARCHAR(24), setup TEXT);
+            CREATE TABLE IF NOT EXISTS plannerConfigs
+              (id INTEGER PRIMARY KEY AUTOINCREMENT, name VARCHAR(512) NOT NULL, settings TEXT);
+            CREATE TABLE IF NOT EXISTS enums
+              (name VARCHAR(512), value INTEGER, description TEXT, PRIMARY KEY (name, value));
+            CREATE TABLE IF NOT EXISTS runs
+              (id INTEGER PRIMARY KEY AUTOINCREMENT, experimentid INTEGER, plannerid INTEGER,
+               FOREIGN KEY (experimentid) REFERENCES experiments(id) ON DELETE CASCADE,
+               FOREIGN KEY (plannerid) REFERENCES plannerConfigs(id) ON DELETE CASCADE);
+            CREATE TABLE IF NOT EXISTS progress
+              (runid INTEGER, time REAL, PRIMARY KEY (runid, time),
+               FOREIGN KEY (runid) REFERENCES runs(id) ON DELETE CASCADE);
+            CREATE TABLE IF NOT EXISTS results
+              (runid INTEGER PRIMARY KEY, encoding TEXT NOT NULL, data BLOB NOT NULL,
+               FOREIGN KEY (runid) REFERENCES runs(id) ON DELETE CASCADE);
+            CREATE TABLE IF NOT EXISTS anyplan_meta (key TEXT PRIMARY KEY, value TEXT);
+        """)
+        self._add_columns("experiments", _EXPERIMENT_EXTRA)
+        self._add_columns("runs", RUN_COLUMNS)
+        self._add_columns("progress", [("best_cost", "REAL"), ("plan_index", "INTEGER"),
+                                       ("source", "TEXT")])
+        c.execute("CREATE INDEX IF NOT EXISTS runs_by_key ON runs (experimentid, plannerid, run_index, seed)")
+        for value, desc in STATUS.items():
+            c.execute("INSERT OR IGNORE INTO enums VALUES ('status', ?, ?)", (value, desc))
+        c.execute("INSERT OR IGNORE INTO anyplan_meta VALUES ('schema_version', ?)", (SCHEMA_VERSION,))
+        self.compute_views()
+        c.commit()
+
+    def _columns(self, table: str) -> list[str]:
+        return [r[1] for r in self.conn.execute(f"PRAGMA table_info({table})")]
+
+    def _add_columns(self, table: str, cols: Iterable[tuple[str, str]]) -> None:
+        have = set(self._columns(table))
+        for name, typ in cols:
+            if name not in have:
+                self.conn.execute(f"ALTER TABLE {table} ADD {name} {typ}")
+
+    def compute_views(self) -> None:
+        """(Re)create OMPL's two summary views (best planner configurations by solved, time)."""
+        base = ("SELECT plannerid, plannerConfigs.name AS plannerName, experimentid, solved, "
+                "time AS total_time FROM plannerConfigs INNER JOIN experiments INNER JOIN runs "
+                "ON plannerConfigs.id = runs.plannerid AND experiments.id = runs.experimentid")
+        per_exp = (f"SELECT plannerid, plannerName, experimentid, AVG(solved) AS avg_solved, "
+                   f"AVG(total_time) AS avg_total_time FROM ({base}) GROUP BY plannerid, experimentid")
+        overall = (f"SELECT plannerid, plannerName, AVG(solved) AS avg_solved, "
+                   f"AVG(total_time) AS avg_total_time FROM ({base}) GROUP BY plannerid")
+        c = self.conn
+        c.execute("DROP VIEW IF EXISTS bestPlannerConfigsPerExperiment")
+        c.execute("CREATE VIEW bestPlannerConfigsPerExperiment AS SELECT plannerid, experimentid, "
+                  f"MAX(avg_solved) AS avg_solved, avg_total_time FROM ({per_exp}) "
+                  "GROUP BY plannerName, experimentid ORDER BY avg_solved DESC, avg_total_time ASC")
+        c.execute("DROP VIEW IF EXISTS bestPlannerConfigs")
+        c.execute("CREATE VIEW bestPlannerConfigs AS SELECT plannerid, MAX(avg_solved) AS avg_solved, "
+                  f"avg_total_time FROM ({overall}) GROUP BY plannerName "
+                  "ORDER BY avg_solved DESC, avg_total_time ASC")
+
+    def close(self) -> None:
+        """Commit and close."""
+        self.conn.commit()
+        self.conn.close()
+
+    def __enter__(self) -> ResultsDB:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # ---------------------------------------------------------------- writing
+    def experiment_id(self, key: ExperimentKey, *, scenario_json: str, moving_obstacles: int,
+                      runcount: int, suite: str) -> int:
+        """The id of the experiment ``key``, created (and committed) if new."""
+        row = self.conn.execute(
+            "SELECT id FROM experiments WHERE name = ? AND scenario_hash = ? AND seed = ? "
+            "AND abs(sim_dt - ?) < 1e-12 AND abs(timelimit - ?) < 1e-9",
+            (key.name, key.scenario_hash, str(key.seed), key.sim_dt, key.timelimit)).fetchone()
+        if row is not None:
+            self.conn.execute("UPDATE experiments SET runcount = max(runcount, ?) WHERE id = ?",
+                              (runcount, row[0]))
+            self.conn.commit()
+            return int(row[0])
+        cur = self.conn.execute(
+            "INSERT INTO experiments (name, totaltime, timelimit, memorylimit, runcount, version, "
+            "hostname, cpuinfo, date, seed, setup, scenario_hash, moving_obstacles, suite, sim_dt) "
+            "VALUES (?, 0.0, ?, 0.0, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            (key.name, key.timelimit, runcount, f"anyplan {__version__}", platform.node(),
+             f"{platform.processor() or platform.machine()}; python {platform.python_version()}",
+             datetime.now(UTC).strftime("%Y-%m-%d %H:%M:%S"), str(key.seed), scenario_json,
+             key.scenario_hash, moving_obstacles, suite, key.sim_dt))
+        self.conn.commit()
+        return int(cur.lastrowid)
+
+    def planner_id(self, name: str, settings: str) -> int:
+        """The id of planner configuration (name, settings), created (and committed) if new."""
+        row = self.conn.execute("SELECT id FROM plannerConfigs WHERE name = ? AND settings = ?",
+                                (name, settings)).fetchone()
+        if row is not None:
+            return int(row[0])
+        cur = self.conn.execute("INSERT INTO plannerConfigs (name, settings) VALUES (?, ?)",
+                                (name, settings))
+        self.conn.commit()
+        return int(cur.lastrowid)
+
+    def done_keys(self) -> set[tuple[int, int, int, int]]:
+        """``(experimentid, plannerid, run_index, seed)`` of every stored run."""
+        return {tuple(r) for r in self.conn.execute(  # type: ignore[misc]
+            "SELECT experimentid, plannerid, run_index, seed FROM runs WHERE run_index IS NOT NULL")}
+
+    def add_run(self, experimentid: int, plannerid: int, row: Mapping[str, Any],
+                result: Mapping[str, Any] | None) -> int:
+        """Insert one finished run (runs, progress, results) and commit it; returns its id."""
+        cols = ["experimentid", "plannerid"] + list(row)
+        vals = [experimentid, plannerid] + list(row.values())
+        with self.conn:  # one transaction: all of the run or nothing
+            cur = self.conn.execute(
+                f"INSERT INTO runs ({', '.join(cols)}) VALUES ({', '.join('?' * len(cols))})", vals)
+            runid = int(cur.lastrowid)
+            if result is not None:
+                self.conn.executemany(
+                    "INSERT OR REPLACE INTO progress (runid, time, best_cost, plan_index, source) "
+                    "VALUES (?, ?, ?, ?, ?)", [(runid, *r) for r in progress_rows(result)])
+                blob = zlib.compress(json.dumps(result, separators=(",", ":")).encode(), 6)
+                self.conn.execute("INSERT INTO results VALUES (?, 'json+zlib', ?)", (runid, blob))
+            wall = row.get("wall_time")
+            if wall is not None:  # OMPL's "seconds spent to collect the data"
+                self.conn.execute("UPDATE experiments SET totaltime = coalesce(totaltime, 0) + ? "
+                                  "WHERE id = ?", (float(wall), experimentid))
+        return runid
+
+    # ---------------------------------------------------------------- reading
+    def result(self, runid: int) -> dict[str, Any] | None:
+        """The whole ``result.json`` of run ``runid`` (None if not stored)."""
+        row = self.conn.execute("SELECT encoding, data FROM results WHERE runid = ?", (runid,)).fetchone()
+        if row is None:
+            return None
+        enc, data = row
+        if enc == "json+zlib":
+            return json.loads(zlib.decompress(data).decode())
+        if enc == "json":
+            return json.loads(data)
+        raise ValueError(f"run {runid}: unknown result encoding '{enc}'")
+
+    def query(self, sql: str, params: tuple[Any, ...] = ()) -> list[dict[str, Any]]:
+        """Rows of ``sql`` as dictionaries."""
+        cur = self.conn.execute(sql, params)
+        names = [d[0] for d in cur.description]
+        return [dict(zip(names, r, strict=True)) for r in cur.fetchall()]
+
+    def runs(self) -> list[dict[str, Any]]:
+        """Every run joined with its planner and experiment (``planner``, ``settings``,
+        ``scenario``, ``n_moving``, ``experiment_seed`` and all run columns)."""
+        have = set(self._columns("experiments"))
+        n_moving = "e.moving_obstacles" if "moving_obstacles" in have else "NULL"
+        return self.query(
+            f"SELECT r.*, p.name AS planner, p.settings AS settings, e.name AS scenario, "
+            f"{n_moving} AS n_moving, e.seed AS experiment_seed, e.version AS experiment_version "
+            "FROM runs r JOIN plannerConfigs p ON p.id = r.plannerid "
+            "JOIN experiments e ON e.id = r.experimentid ORDER BY r.id")
+
+    def progress(self, runid: int) -> list[dict[str, Any]]:
+        """Progress rows of run ``runid``, by time."""
+        return self.query("SELECT * FROM progress WHERE runid = ? ORDER BY time", (runid,))
+
+    def experiments(self) -> list[dict[str, Any]]:
+        """All experiment rows."""
+        return self.query("SELECT * FROM experiments ORDER BY id")

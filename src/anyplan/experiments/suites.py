@@ -1,0 +1,65 @@
+"""Scenario suites for ``anyplan bench``: named sets of scenarios.
+
+``resolve_suite`` accepts:
+
+* ``paper``: the built-in ``paper-1``, ``paper-2``, ``paper-3`` (1, 2 and 3 moving obstacles);
+* ``random``: generated scenarios (:mod:`anyplan.experiments.generate`), ``per_count`` for each
+  number of moving obstacles 1-6, from ``random_seed``;
+* a folder: every ``*.yaml`` / ``*.yml`` file in it, sorted by name;
+* a comma-separated list of scenario files or built-in names.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from anyplan.errors import AnyplanError
+from anyplan.experiments.generate import random_suite
+from anyplan.world.scenario import Scenario, load_scenario
+
+__all__ = ["resolve_suite", "PAPER_SUITE", "SuiteError"]
+
+PAPER_SUITE = ("paper-1", "paper-2", "paper-3")
+
+
+class SuiteError(AnyplanError):
+    """A suite cannot be resolved to scenarios."""
+
+
+def resolve_suite(suite: str, random_seed: int = 0, per_count: int = 1) -> list[Scenario]:
+    """The scenarios of ``suite`` (see the module docstring).
+
+    Raises:
+        SuiteError: an empty folder or list, or two scenarios with one name.
+        ScenarioError, UnknownNameError: a file or name that does not load.
+    """
+    if suite == "paper":
+        scenarios = [load_scenario(n) for n in PAPER_SUITE]
+    elif suite == "random":
+        if per_count < 1:
+            raise SuiteError(f"--random-count must be >= 1, got {per_count}")
+        scenarios = random_suite(random_seed, per_count=per_count)
+    elif Path(suite).is_dir():
+        files = sorted(p for p in Path(suite).iterdir() if p.suffix in (".yaml", ".yml"))
+        if not files:
+            raise SuiteError(f"suite folder '{suite}' holds no .yaml scenario files")
+        scenarios = [load_scenario(p) for p in files]
+    else:
+        items = [s.strip() for s in suite.split(",") if s.strip()]
+        if not items:
+            raise SuiteError("empty --suite")
+        scenarios = [load_scenario(s) for s in items]
+    seen: dict[str, str] = {}
+    for sc in scenarios:
+        h = sc.content_hash()
+        if sc.name in seen and seen[sc.name] != h:
+            raise SuiteError(f"two different scenarios are named '{sc.name}' ({sc.source})")
+        seen[sc.name] = h
+    # Drop exact duplicates (same name and content), keep order.
+    out, keys = [], set()
+    for sc in scenarios:
+        k = (sc.name, sc.content_hash())
+        if k not in keys:
+            keys.add(k)
+            out.append(sc)
+    return out

@@ -1,0 +1,227 @@
+"""Tables like the paper's Tables 2 and 3, computed from the results database.
+
+One table per planner configuration, one row per number of moving obstacles. Columns, as in
+the paper, plus the outcome counts the paper reports only as "crashed":
+
+* path length [m]: executed path length, mean ± sample std over the runs that reached the goal;
+* path generation time [s]: per run, the mean wall time of its planning calls; mean ± std over
+  runs that planned at least once (this is our reading of the paper's "path generation time");
+* time to goal [s]: simulated time to reach the goal, mean ± std over successful runs;
+* successes (reached the goal without collision), crashes (collided with an obstacle),
+  timeouts (neither within the time limit), errors (the planner raised; OMPL's "Crash").
+
+The paper's own numbers (Roy, Harchowdhury & Vachhani, Tables 2-3) are in :data:`PAPER_TABLES`.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["PAPER_TABLES", "Stat", "TableRow", "PlannerTable", "summarize", "format_text",
+           "format_markdown", "format_csv", "format_paper_comparison", "write_tables"]
+
+#: The paper's figures per planner registry name and number of moving obstacles:
+#: (path length [m], path generation time [s], time to goal [s]), or None for "crashed".
+PAPER_TABLES: dict[str, dict[str, Any]] = {
+    "dovs": {"title": "DOVS (paper Table 2)",
+             "rows": {1: (18.762, 0.25188, 50.1), 2: (18.4852, 0.207315, 56.006), 3: None}},
+    "seq-bitstar": {"title": "Sequential BIT* (paper Table 3)",
+                    "rows": {1: (12.076, 0.1841, 40.766), 2: (12.003, 0.1716, 40.218),
+                             3: (12.115, 0.1835, 40.655)}},
+}
+
+
+@dataclass(frozen=True)
+class Stat:
+    """Mean and sample standard deviation of ``n`` values (NaN when n == 0; std NaN when n < 2)."""
+
+    mean: float
+    std: float
+    n: int
+
+    @staticmethod
+    def of(values: Iterable[float | None]) -> Stat:
+        """Statistics of the finite values in ``values``."""
+        v = np.array([x for x in values if x is not None and math.isfinite(x)], dtype=float)
+        if v.size == 0:
+            return Stat(math.nan, math.nan, 0)
+        return Stat(float(v.mean()), float(v.std(ddof=1)) if v.size > 1 else math.nan, int(v.size))
+
+    def fmt(self, digits: int = 3) -> str:
+        """``mean ± std`` (``-`` when empty)."""
+        if self.n == 0:
+            return "-"
+        if not math.isfinite(self.std):
+            return f"{self.mean:.{digits}f}"
+        return f"{self.mean:.{digits}f} ± {self.std:.{digits}f}"
+
+
+@dataclass(frozen=True)
+class TableRow:
+    """One row: the runs of one planner on scenarios with ``n_moving`` moving obstacles."""
+
+    n_moving: int
+    runs: int
+    successes: int
+    crashes: int
+    timeouts: int
+    errors: int
+    path_length: Stat
+    generation_time: Stat
+    time_to_goal: Stat
+
+
+@dataclass
+class PlannerTable:
+    """The table of one planner configuration."""
+
+    planner: str
+    settings: str
+    rows: list[TableRow] = field(default_factory=list)
+
+    @property
+    def title(self) -> str:
+        """Planner name, with its settings if not the defaults."""
+        return self.planner + (f" [{self.settings}]" if self.settings else "")
+
+
+def summarize(runs: Sequence[Mapping[str, Any]]) -> list[PlannerTable]:
+    """Tables from run rows as returned by :meth:`ResultsDB.runs`.
+
+    Rows without ``outcome`` or ``n_moving`` (e.g. imported OMPL runs) are ignored.
+    """
+    groups: dict[tuple[str, str], dict[int, list[Mapping[str, Any]]]] = {}
+    for r in runs:
+        if r.get("outcome") is None or r.get("n_moving") is None:
+            continue
+        key = (str(r["planner"]), str(r.get("settings") or ""))
+        groups.setdefault(key, {}).setdefault(int(r["n_moving"]), []).append(r)
+    tables = []
+    for (name, settings), by_n in groups.items():
+        t = PlannerTable(name, settings)
+        for n in sorted(by_n):
+            rs = by_n[n]
+            ok = [r for r in rs if r["outcome"] == "reached"]
+            t.rows.append(TableRow(
+                n_moving=n, runs=len(rs), successes=len(ok),
+                crashes=sum(r["outcome"] == "collision" for r in rs),
+                timeouts=sum(r["outcome"] == "timeout" for r in rs),
+                errors=sum(r["outcome"] == "error" for r in rs),
+                path_length=Stat.of(r["path_length"] for r in ok),
+                generation_time=Stat.of(r.get("planning_time_mean") for r in rs
+                                        if (r.get("planning_calls") or 0) > 0),
+                time_to_goal=Stat.of(r["time_to_goal"] for r in ok)))
+        tables.append(t)
+    order = {"seq-bitstar": 0, "bitstar": 1, "dovs": 2}
+    tables.sort(key=lambda t: (order.get(t.planner, 9), t.planner, t.settings))
+    return tables
+
+
+HEADERS = ["moving obstacles", "path length [m]", "path generation time [s]", "time to goal [s]",
+           "successes", "crashes", "timeouts", "errors"]
+
+
+def _cells(row: TableRow) -> list[str]:
+    return [str(row.n_moving), row.path_length.fmt(3), row.generation_time.fmt(4),
+            row.time_to_goal.fmt(2), f"{row.successes}/{row.runs}", str(row.crashes),
+            str(row.timeouts), str(row.errors)]
+
+
+def _grid(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    w = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(headers)]
+    line = "  ".join(h.rjust(w[i]) for i, h in enumerate(headers))
+    out = [line, "-" * len(line)]
+    out += ["  ".join(c.rjust(w[i]) for i, c in enumerate(r)) for r in rows]
+    return "\n".join(out)
+
+
+def format_text(tables: Sequence[PlannerTable]) -> str:
+    """Plain-text tables for a terminal."""
+    parts = []
+    for t in tables:
+        parts.append(f"{t.title}\n" + _grid(HEADERS, [_cells(r) for r in t.rows]))
+    return "\n\n".join(parts) if parts else "(no runs)"
+
+
+def _md(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    out = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
+    out += ["| " + " | ".join(r) + " |" for r in rows]
+    return "\n".join(out)
+
+
+def format_markdown(tables: Sequence[PlannerTable]) -> str:
+    """Markdown tables (one per planner) followed by the comparison with the paper."""
+    parts = []
+    for t in tables:
+        parts.append(f"### {t.title}\n\n" + _md(HEADERS, [_cells(r) for r in t.rows]))
+    cmp = format_paper_comparison(tables, markdown=True)
+    if cmp:
+        parts.append("### Ours against the paper\n\n" + cmp)
+    return "\n\n".join(parts) + "\n"
+
+
+def format_csv(tables: Sequence[PlannerTable]) -> str:
+    """CSV: one line per (planner, number of moving obstacles), means and stds in own columns."""
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(["planner", "settings", "moving_obstacles", "runs", "successes", "crashes", "timeouts",
+                "errors", "path_length_mean_m", "path_length_std_m", "generation_time_mean_s",
+                "generation_time_std_s", "time_to_goal_mean_s", "time_to_goal_std_s"])
+
+    def num(x: float) -> str:
+        return "" if not math.isfinite(x) else f"{x:.6g}"
+
+    for t in tables:
+        for r in t.rows:
+            w.writerow([t.planner, t.settings, r.n_moving, r.runs, r.successes, r.crashes, r.timeouts,
+                        r.errors, num(r.path_length.mean), num(r.path_length.std),
+                        num(r.generation_time.mean), num(r.generation_time.std),
+                        num(r.time_to_goal.mean), num(r.time_to_goal.std)])
+    return buf.getvalue()
+
+
+def format_paper_comparison(tables: Sequence[PlannerTable], markdown: bool = False) -> str:
+    """The paper's Tables 2-3 beside ours, for the planners the paper reports (empty if none)."""
+    headers = ["moving obstacles", "path length [m] ours", "paper", "generation time [s] ours",
+               "paper", "time to goal [s] ours", "paper", "successes ours"]
+    parts = []
+    for t in tables:
+        paper = PAPER_TABLES.get(t.planner)
+        if paper is None:
+            continue
+        mine = {r.n_moving: r for r in t.rows}
+        rows = []
+        for n in sorted(set(mine) | set(paper["rows"])):
+            r = mine.get(n)
+            p = paper["rows"].get(n, "n/a")
+            if p is None:
+                pc = ["crashed"] * 3
+            elif p == "n/a":
+                pc = ["-"] * 3
+            else:
+                pc = [f"{p[0]:g}", f"{p[1]:g}", f"{p[2]:g}"]
+            ours = ([r.path_length.fmt(3), r.generation_time.fmt(4), r.time_to_goal.fmt(2),
+                     f"{r.successes}/{r.runs}"] if r else ["-", "-", "-", "-"])
+            rows.append([str(n), ours[0], pc[0], ours[1], pc[1], ours[2], pc[2], ours[3]])
+        title = f"{t.title} against {paper['title']}"
+        parts.append((f"**{title}**\n\n" + _md(headers, rows)) if markdown
+                     else f"{title}\n" + _grid(headers, rows))
+    return "\n\n".join(parts)
+
+
+def write_tables(tables: Sequence[PlannerTable], out: str | Path) -> list[Path]:
+    """Write ``tables.md`` and ``tables.csv`` into folder ``out``; returns the paths."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    md, cs = out / "tables.md", out / "tables.csv"
+    md.write_text("# Benchmark tables\n\n" + format_markdown(tables))
+    cs.write_text(format_csv(tables))
+    return [md, cs]
