@@ -23,6 +23,7 @@ __all__ = ["main", "COMMAND_MODULES", "UsageError"]
 #: Modules that each register one or more sub-commands.
 COMMAND_MODULES = [
     "anyplan.cli.cmd_run",
+    "anyplan.cli.cmd_bench",
 ]
 
 

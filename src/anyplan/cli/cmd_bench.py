@@ -1,0 +1,125 @@
+"""``anyplan bench`` (run a benchmark into a results database) and ``anyplan report``."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+DESCRIPTION = """\
+Run every (scenario, planner, run) in parallel processes (or on a Dask cluster) and store each
+finished run at once in an SQLite database laid out like OMPL's benchmark database. Prints
+tables like the paper's Tables 2-3 (one per planner, one row per number of moving obstacles)
+and the paper's own figures beside ours. Ctrl-C loses no finished run; --resume runs only the
+missing ones."""
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``bench`` and ``report`` sub-commands."""
+    p = sub.add_parser("bench", help="benchmark planners on a suite of scenarios",
+                       description=DESCRIPTION)
+    p.add_argument("--suite", default="paper",
+                   help="'paper' (paper-1..3), 'random' (generated), a folder of scenario YAML "
+                        "files, or a comma-separated list of files/built-in names (default paper)")
+    p.add_argument("--planners", default="straight",
+                   help="comma-separated planner names (default straight)")
+    p.add_argument("--runs", type=int, default=30, help="runs per (scenario, planner) (default 30)")
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
+                   help="worker processes (default: the number of CPUs; 1 = no subprocess)")
+    p.add_argument("--db", default="results.db", help="SQLite results database (default results.db)")
+    p.add_argument("--out", default=None, help="folder for tables.md and tables.csv")
+    p.add_argument("--resume", action="store_true",
+                   help="run only the runs missing from --db (after an interruption)")
+    p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                   help="run on this Dask scheduler (needs the 'dask' extra) instead of --jobs")
+    p.add_argument("--seed", type=int, default=0,
+                   help="master seed; run i uses a seed derived from (seed, i) (default 0)")
+    p.add_argument("--random-count", type=int, default=1,
+                   help="--suite random: scenarios per number of moving obstacles 1-6 (default 1)")
+    p.add_argument("--random-seed", type=int, default=None,
+                   help="--suite random: generator seed (default: --seed)")
+    p.add_argument("--dt", type=float, default=0.05, help="simulation step [s] (default 0.05)")
+    p.add_argument("--time-limit", type=float, default=None,
+                   help="simulated time limit [s] (default: each scenario's)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_bench)
+
+    r = sub.add_parser("report", help="figures, tables and an HTML report from a results database",
+                       description="Read only the results database and write DIR/report.html "
+                       "(self-contained), the paper's Figure 4 grid, box plots, cost against "
+                       "time, and the tables as Markdown and CSV.")
+    r.add_argument("db", help="results database written by 'anyplan bench'")
+    r.add_argument("--out", default="report", help="output folder (default report)")
+    r.set_defaults(func=cmd_report)
+
+
+def _usage(msg: str) -> Exception:
+    from anyplan.cli.main import UsageError
+
+    return UsageError(msg)
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    """Run the bench, then print and write the tables."""
+    from anyplan.experiments.db import ResultsDB, settings_string
+    from anyplan.experiments.runner import BenchInterrupted, parse_planners, run_bench
+    from anyplan.experiments.suites import resolve_suite
+    from anyplan.experiments.tables import format_paper_comparison, format_text, summarize, write_tables
+
+    if args.runs < 1:
+        raise _usage(f"bench: --runs must be >= 1, got {args.runs}")
+    if args.jobs < 1:
+        raise _usage(f"bench: --jobs must be >= 1, got {args.jobs}")
+    planners = parse_planners(args.planners)
+    scenarios = resolve_suite(args.suite, random_seed=args.seed if args.random_seed is None
+                              else args.random_seed, per_count=args.random_count)
+    db_path = Path(args.db)
+    if db_path.parent and not db_path.parent.exists():
+        raise _usage(f"bench: --db {db_path}: folder {db_path.parent} does not exist")
+    if args.resume and not db_path.exists():
+        raise _usage(f"bench: --resume: {db_path} does not exist")
+    try:
+        summary = run_bench(scenarios, planners, args.runs, db_path, master_seed=args.seed,
+                            jobs=args.jobs, dt=args.dt, time_limit=args.time_limit,
+                            resume=args.resume, scheduler=args.scheduler, suite=args.suite,
+                            progress=not args.no_progress)
+    except BenchInterrupted as exc:
+        sys.stderr.write(f"anyplan: bench stopped: {exc}\n")
+        return 1
+    hashes = {sc.content_hash() for sc in scenarios}
+    configs = {(p.name, settings_string(p.config)) for p in planners}
+    with ResultsDB(db_path) as db:
+        runs = [r for r in db.runs()
+                if r["scenario_hash"] in hashes and str(r["experiment_seed"]) == str(args.seed)
+                and (r["planner"], r["settings"] or "") in configs]
+    tables = summarize(runs)
+    print(f"{summary.finished} runs now, {summary.skipped} already stored; "
+          f"{len(runs)} runs in {db_path} for this bench ({summary.wall_time_s:.1f} s)\n")
+    print(format_text(tables))
+    cmp = format_paper_comparison(tables)
+    if cmp:
+        print("\n" + cmp)
+    if args.out:
+        try:
+            paths = write_tables(tables, args.out)
+        except OSError as exc:
+            raise _usage(f"bench: --out {args.out}: cannot write ({exc.strerror})") from None
+        print("\nwrote " + ", ".join(str(p) for p in paths))
+    return 0
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    """Write the figures and the HTML report of a results database."""
+    db = Path(args.db)
+    if not db.is_file():
+        raise _usage(f"report: {db}: no such database")
+    from anyplan.viz.report import build_report
+
+    try:
+        paths = build_report(db, args.out)
+    except OSError as exc:
+        raise _usage(f"report: --out {args.out}: cannot write ({exc.strerror})") from None
+    for p in paths:
+        print(f"wrote {p}")
+    return 0
