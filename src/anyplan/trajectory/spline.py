@@ -2,10 +2,12 @@
 
 The paper (Roy, Harchowdhury & Vachhani, "Anytime Planning: A Motion Planner for Dynamic
 Environment", §4) turns BIT*'s polyline into a smooth curve with a cubic spline. Here the spline
-interpolates the path's points with ``scipy.interpolate.CubicSpline``, parameterised by (very
-nearly) arc length: the knots start at the cumulative chord lengths and are then replaced, a few
-times, by the arc lengths of the previous fit. The exact arc length s(u) is tabulated by
-Gauss-Legendre quadrature, so nothing downstream depends on the parameter being exactly s.
+interpolates the path's points with ``scipy.interpolate.CubicSpline`` and is parameterised by arc
+length: a first fit uses chord lengths as knots, which are then replaced (twice) by the arc
+lengths of the previous fit; finally the fit is resampled at short parameter steps, every sample
+(the interpolation points among them) gets its exact arc length (Gauss-Legendre quadrature) as
+its parameter, and the spline is fitted again through these samples. The arc length s(u) is also
+tabulated exactly on the evaluation grid, so nothing downstream depends on |r'(u)| being 1.
 
 End conditions: natural (zero curvature) at the end; at the start either natural, or a clamped
 unit tangent when a start heading is given (the curve leaves the start along that heading).
@@ -42,6 +44,9 @@ __all__ = ["SmoothCurve", "SmoothingResult", "clean_path", "curve_clearance_ok",
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(5)
 _GL_X = 0.5 * (_GL_X + 1.0)
 _GL_W = 0.5 * _GL_W
+
+#: Largest tangent turn [rad] across one evaluation-grid interval.
+MAX_TURN = 0.05
 
 
 def clean_path(path: np.ndarray, tol: float = 1e-9, collinear_tol: float = 1e-9) -> np.ndarray:
@@ -81,26 +86,30 @@ def clean_path(path: np.ndarray, tol: float = 1e-9, collinear_tol: float = 1e-9)
 
 
 class SmoothCurve:
-    """A planar cubic spline r(u) through ``points``, with u close to arc length.
+    """A planar cubic spline r(u) through ``points``, parameterised by arc length u.
 
     Args:
         points: Interpolation points (N >= 2, 2) [m], consecutive points distinct.
         start_heading: If given, the curve leaves ``points[0]`` along this heading [rad]
             (clamped unit tangent); otherwise the start is natural (zero curvature).
         grid_step: Target spacing [m] of the evaluation grid used for arc length tables,
-            speed profiles and collision certification.
-        reparam_iters: Number of knot updates toward arc length.
+            speed profiles and collision certification (finer where the tangent turns by more
+            than ``MAX_TURN`` across a step).
+        reparam_iters: Number of knot updates toward arc length before the final refit.
+        resample_step: Parameter step [m] of the arc-length refit.
 
     Attributes:
         points: The interpolation points (N, 2).
-        knots: Spline parameters of the points (N,).
+        point_u: Curve parameter (= arc length) of each interpolation point (N,).
+        knots: Knots of the final spline (every interpolation point and the resampled points).
         u_grid: Evaluation grid in u, containing every knot (M,).
         s_grid: Exact arc length [m] at ``u_grid`` (M,).
         length: Total arc length [m].
     """
 
     def __init__(self, points: np.ndarray, start_heading: float | None = None,
-                 grid_step: float = 0.02, reparam_iters: int = 3) -> None:
+                 grid_step: float = 0.02, reparam_iters: int = 2,
+                 resample_step: float = 0.05) -> None:
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
         if len(pts) < 2:
             raise ValueError("a curve needs at least two points")
@@ -118,18 +127,36 @@ class SmoothCurve:
         for _ in range(max(reparam_iters, 0)):
             cs = CubicSpline(u, pts, axis=0, bc_type=bc)
             u = np.concatenate([[0.0], np.cumsum(self._piece_lengths(cs, u))])
-        self.knots = u
-        self._cs = CubicSpline(u, pts, axis=0, bc_type=bc)
+        cs = CubicSpline(u, pts, axis=0, bc_type=bc)
+        # Arc-length parameterisation: resample every piece at equal parameter steps, take the
+        # exact arc length of each sample as its parameter and interpolate again. The samples
+        # include the interpolation points, so those (and the end conditions) are kept; the
+        # refit is unit speed to within ~1e-4 and departs from the first fit by far less.
+        sub = [np.linspace(u[k], u[k + 1], max(4, math.ceil((u[k + 1] - u[k]) / resample_step)) + 1)[:-1]
+               for k in range(len(u) - 1)]
+        us = np.concatenate(sub + [u[-1:]])
+        s_of_us = np.concatenate([[0.0], np.cumsum(self._piece_lengths(cs, us))])
+        self.point_u = s_of_us[np.searchsorted(us, u)]
+        self.knots = s_of_us
+        self._cs = CubicSpline(s_of_us, cs(us), axis=0, bc_type=bc)
+        u = self.knots
         self._d1 = self._cs.derivative(1)
         self._d2 = self._cs.derivative(2)
         self._d3 = self._cs.derivative(3)
         # Evaluation grid: every knot, each piece cut into equal parts of about grid_step.
-        parts = [np.linspace(u[k], u[k + 1], max(1, math.ceil((u[k + 1] - u[k]) / grid_step)) + 1)[:-1]
-                 for k in range(len(u) - 1)]
+        # A piece is also cut finely enough that the tangent turns by at most MAX_TURN per part.
+        fr = np.linspace(0.0, 1.0, 9)
+        uu = u[:-1, None] + np.diff(u)[:, None] * fr[None, :]
+        k_est, _ = self.curvature(uu.ravel())
+        turn = np.abs(k_est).reshape(uu.shape).max(axis=1) * np.diff(u)
+        n_parts = np.maximum(np.ceil(np.diff(u) / grid_step), np.ceil(turn / MAX_TURN))
+        n_parts = np.clip(n_parts, 1, 400).astype(int)
+        parts = [np.linspace(u[k], u[k + 1], n_parts[k] + 1)[:-1] for k in range(len(u) - 1)]
         self.u_grid = np.concatenate(parts + [u[-1:]])
         ds = self._sub_lengths(self.u_grid)
         self.s_grid = np.concatenate([[0.0], np.cumsum(ds)])
         self.length = float(self.s_grid[-1])
+        self._dus = 1.0 / np.hypot(*self._d1(self.u_grid).T)
 
     # --- evaluation -------------------------------------------------------------------------
     @staticmethod
@@ -177,13 +204,44 @@ class SmoothCurve:
         return kappa, dk_du / sp
 
     def u_of_s(self, s: np.ndarray) -> np.ndarray:
-        """Parameter u at arc length ``s`` [m] (linear in the grid table; error << 1 mm)."""
-        return np.interp(np.asarray(s, dtype=float), self.s_grid, self.u_grid)
+        """Parameter u at arc length ``s`` [m].
 
-    def knot_index(self, u: np.ndarray) -> np.ndarray:
-        """Index k of the spline interval [knots[k], knots[k+1]] containing each ``u``."""
-        k = np.searchsorted(self.knots, np.asarray(u, dtype=float), side="right") - 1
-        return np.clip(k, 0, len(self.knots) - 2)
+        Cubic Hermite interpolation of u(s) on the grid, with the exact slopes du/ds = 1/|r'(u)|
+        at the grid points: error O(ds^4), so the speed along the curve is 1 to ~1e-6.
+        """
+        s = np.clip(np.asarray(s, dtype=float), 0.0, self.length)
+        i = np.clip(np.searchsorted(self.s_grid, s, side="right") - 1, 0, len(self.s_grid) - 2)
+        h = self.s_grid[i + 1] - self.s_grid[i]
+        x = (s - self.s_grid[i]) / h
+        u0, u1 = self.u_grid[i], self.u_grid[i + 1]
+        m0, m1 = self._dus[i] * h, self._dus[i + 1] * h
+        x2, x3 = x * x, x * x * x
+        return ((2 * x3 - 3 * x2 + 1) * u0 + (x3 - 2 * x2 + x) * m0 + (-2 * x3 + 3 * x2) * u1
+                + (x3 - x2) * m1)
+
+    def point_index(self, u: np.ndarray) -> np.ndarray:
+        """Index k of the interpolation interval [point_u[k], point_u[k+1]] containing each ``u``."""
+        k = np.searchsorted(self.point_u, np.asarray(u, dtype=float), side="right") - 1
+        return np.clip(k, 0, len(self.point_u) - 2)
+
+    def is_regular(self, min_speed: float = 0.2) -> bool:
+        """True if the curve has no cusp: |r'(u)| stays near 1 and the heading turns no faster
+        than the curvature allows between grid points.
+
+        A clamped start heading opposite to the path can fold the spline back on itself (a cusp,
+        where the heading flips by pi at zero speed); such a curve cannot be driven.
+        """
+        u = self.u_grid
+        mid = 0.5 * (u[:-1] + u[1:])
+        sp = np.hypot(*self.derivatives(np.concatenate([u, mid]))[0].T)
+        if np.min(sp) < min_speed:
+            return False
+        th = self.heading(u)
+        dth = np.abs(np.angle(np.exp(1j * np.diff(th))))
+        k_end, _ = self.curvature(u)
+        k_mid, _ = self.curvature(mid)
+        kb = np.maximum.reduce([np.abs(k_end[:-1]), np.abs(k_end[1:]), np.abs(k_mid)])
+        return bool(np.all(dth <= 1.5 * kb * np.diff(self.s_grid) + 1e-6))
 
     def samples(self, step: float = 0.05) -> np.ndarray:
         """Points (M, 2) [m] along the curve about ``step`` apart, endpoints included."""
@@ -203,8 +261,8 @@ def curve_clearance_ok(curve: SmoothCurve, obstacles: ObstacleSet, radius: float
             is reported as colliding.
 
     Returns:
-        ``(free, bad, margin)``: whether the whole curve is certified free; the sorted spline
-        interval indices (into ``curve.knots``) that could not be certified; and a certified
+        ``(free, bad, margin)``: whether the whole curve is certified free; the sorted indices k
+        of the interpolation intervals (``curve.point_u[k:k+2]``) that could not be certified; and a certified
         lower bound [m] of the clearance minus ``radius`` over the certified pieces.
     """
     u = curve.u_grid
@@ -230,7 +288,7 @@ def curve_clearance_ok(curve: SmoothCurve, obstacles: ObstacleSet, radius: float
             a_u = b_u = np.zeros(0)
             break
         if depth == max_depth:
-            bad_idx.extend(curve.knot_index(0.5 * (a_u[fail] + b_u[fail])).tolist())
+            bad_idx.extend(curve.point_index(0.5 * (a_u[fail] + b_u[fail])).tolist())
             break
         fa, fb = a_u[fail], b_u[fail]
         parts = np.linspace(0.0, 1.0, 5)
@@ -245,7 +303,8 @@ class SmoothingResult:
     """Outcome of :func:`smooth_path`.
 
     Attributes:
-        curve: The certified collision-free curve, or None if repair failed.
+        curve: The certified collision-free curve, or None if repair failed or the curve has a
+            cusp (see :meth:`SmoothCurve.is_regular`).
         rounds: Repair rounds used (0: the first spline was free).
         points_added: Interpolation points inserted by the repair.
         margin: Certified clearance above the required radius [m] (nan if no curve).
@@ -280,6 +339,9 @@ def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
     n0 = len(pts)
     for rnd in range(max_rounds + 1):
         curve = SmoothCurve(pts, start_heading=start_heading, grid_step=grid_step)
+        if not curve.is_regular():
+            # a cusp comes from the start heading, which no repair changes
+            return SmoothingResult(None, rnd, len(pts) - n0, float("nan"))
         free, bad, margin = curve_clearance_ok(curve, obstacles, radius)
         if free:
             return SmoothingResult(curve, rnd, len(pts) - n0, margin)

@@ -1,0 +1,124 @@
+"""plan_motion and Trajectory: the whole chain on hand-made paths and random static worlds."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from anyplan.geometry import Circle, ObstacleSet, rectangle
+from anyplan.trajectory import Trajectory, plan_motion, polyline_trajectory
+from anyplan.world import RobotState, load_scenario
+
+PAPER_PATH = np.array([[1.5, 5.5], [5.5, 5.5], [6.0, 5.0], [8.0, 5.2], [13.5, 5.5]])
+
+
+def dense_clearance(traj: Trajectory, obstacles: ObstacleSet, dt: float = 2e-3) -> float:
+    t = np.arange(traj.t_start, traj.t_end + dt, dt)
+    return float(obstacles.clearances(traj.positions(t)).min())
+
+
+def test_sample_contract_and_hold_after_end():
+    sc = load_scenario("paper-1").static_only()
+    tr = plan_motion(PAPER_PATH, sc.robot, RobotState(1.5, 5.5, 0.0), sc.obstacle_set(), 2.0)
+    assert tr.t_start == 2.0 and tr.t_end > tr.t_start
+    t = np.linspace(0.0, tr.t_end + 3.0, 77).reshape(7, 11)
+    vals = tr.sample(t)
+    assert all(v.shape == (7, 11) for v in vals)
+    assert tr.positions(t.ravel()).shape == (77, 2)
+    np.testing.assert_allclose(tr.positions(np.array([2.0])), [[1.5, 5.5]], atol=1e-12)
+    # before the start: held at the start pose
+    x, y, th, v, w = tr.sample(np.array([0.0, 2.0]))
+    assert x[0] == x[1] and y[0] == y[1] and th[0] == th[1]
+    xe, ye, _, ve, we = tr.sample(np.array([tr.t_end, tr.t_end + 100.0]))
+    np.testing.assert_allclose([xe[0], ye[0]], [13.5, 5.5], atol=1e-9)
+    assert ve[1] == 0.0 and we[1] == 0.0 and xe[1] == xe[0]
+    assert tr.path.shape[1] == 2
+    assert np.allclose(tr.path[0], [1.5, 5.5]) and np.allclose(tr.path[-1], [13.5, 5.5])
+    assert tr.length == pytest.approx(float(np.sum(np.hypot(*np.diff(tr.path, axis=0).T))), rel=1e-3)
+    assert isinstance(tr.state(5.0), tuple) and len(tr.state(5.0)) == 5
+
+
+def test_paper_path_limits_clearance_and_bound(limits_checker):
+    sc = load_scenario("paper-1").static_only()
+    obs, spec = sc.obstacle_set(), sc.robot
+    tr = plan_motion(PAPER_PATH, spec, RobotState(1.5, 5.5, 0.0), obs, 0.0)
+    limits_checker(tr, spec)
+    assert dense_clearance(tr, obs) >= spec.radius - 1e-9
+    assert tr.lower_bound_s <= tr.duration <= 1.10 * tr.lower_bound_s
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_random_worlds_chain(seed, world_factory, limits_checker):
+    obs, path, spec = world_factory(seed)
+    st = RobotState(spec.start[0], path[0, 1], spec.start[2] + (0.8 if seed % 2 else 0.0))
+    tr = plan_motion(path, spec, st, obs, 1.0)
+    assert tr.kind in ("smooth", "turn+smooth", "polyline")
+    limits_checker(tr, spec)
+    assert dense_clearance(tr, obs) >= spec.radius - 1e-9
+    np.testing.assert_allclose(tr.positions(np.array([tr.t_end])), path[-1:], atol=1e-9)
+    assert tr.duration >= tr.lower_bound_s - 1e-9
+
+
+@pytest.mark.parametrize("theta", [0.0, 0.6, -1.2, 2.5])
+def test_start_while_moving(theta, limits_checker):
+    # Replanning on the move: v0 = 0.3 m/s, omega0 = 0.1 rad/s, heading theta.
+    obs = ObstacleSet([Circle((5.0, 3.0), 0.7)], bounds=(0.0, 0.0, 10.0, 6.0))
+    spec = load_scenario("paper-1").robot
+    path = np.array([[2.0, 3.0], [4.0, 4.3], [6.5, 4.3], [8.5, 3.0]])
+    st = RobotState(2.0, 3.0, theta, 0.3, 0.1)
+    tr = plan_motion(path, spec, st, obs, 10.0)
+    x, y, th, v, w = tr.sample(np.array([10.0]))
+    assert v[0] == pytest.approx(0.3)
+    assert th[0] == pytest.approx(theta)
+    assert tr.feasible
+    limits_checker(tr, spec)
+    assert dense_clearance(tr, obs) >= spec.radius - 1e-9
+    c = tr.info["candidates"]
+    assert tr.duration == pytest.approx(min(c.values()))
+    if abs(theta) > 0.01:
+        assert "turn+smooth" in c  # braking and turning in place was considered
+
+
+def test_zero_slack_path_falls_back_to_polyline(limits_checker):
+    # The polyline runs at exactly the robot radius along a wall into a corner: no spline through
+    # its corner can stay on the free side, so the chain falls back to turning in place.
+    r = 0.3
+    path = np.array([[1.0, 4.0], [5.0, 2.0], [9.0, 4.0]])
+    d = (path[1] - path[0]) / np.hypot(*(path[1] - path[0]))
+    n = np.array([d[1], -d[0]])
+    box = rectangle((3.0, 3.0) + n * (r + 0.25), (3.0, 0.5), math.atan2(d[1], d[0]))
+    obs = ObstacleSet([box], bounds=(0.0, 0.0, 10.0, 6.0))
+    spec = load_scenario("paper-1").robot
+    st = RobotState(1.0, 4.0, math.atan2(d[1], d[0]))
+    tr = plan_motion(path, spec, st, obs, 0.0, max_repair_rounds=4)
+    assert tr.kind == "polyline"
+    limits_checker(tr, spec)
+    assert dense_clearance(tr, obs) >= r - 1e-9
+    # straight legs: the path is exactly the polyline
+    rel = tr.path[:10] - path[0]
+    assert np.max(np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0])) < 1e-9
+
+
+def test_polyline_trajectory_direct(limits_checker):
+    spec = load_scenario("paper-1").robot
+    tr = polyline_trajectory(PAPER_PATH, spec, RobotState(1.5, 5.5, 1.0), 0.0)
+    limits_checker(tr, spec)
+    assert [s.kind for s in tr.segments][:2] == ["turn", "curve"]
+    assert tr.length == pytest.approx(float(np.sum(np.hypot(*np.diff(PAPER_PATH, axis=0).T))))
+
+
+def test_max_speed_bounds_position_rate():
+    sc = load_scenario("paper-1").static_only()
+    tr = plan_motion(PAPER_PATH, sc.robot, RobotState(1.5, 5.5, 0.0), sc.obstacle_set(), 0.0)
+    assert sc.robot.v_max <= tr.max_speed <= 1.02 * sc.robot.v_max
+    t = np.arange(0.0, tr.t_end, 1e-3)
+    p = tr.positions(t)
+    assert np.max(np.hypot(*np.diff(p, axis=0).T) / 1e-3) <= tr.max_speed
+
+
+def test_already_at_goal_holds():
+    spec = load_scenario("paper-1").robot
+    tr = plan_motion(np.array([[3.0, 3.0]]), spec, RobotState(3.0, 3.0, 0.0), ObstacleSet(), 0.0)
+    assert tr.kind == "hold" and tr.length == 0.0

@@ -1,0 +1,121 @@
+"""Cubic-spline smoothing: interpolation, arc length, certified collision check and repair."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from anyplan.geometry import Circle, ObstacleSet, rectangle
+from anyplan.trajectory import SmoothCurve, clean_path, curve_clearance_ok, smooth_path
+
+
+def dense_min_clearance(curve: SmoothCurve, obstacles: ObstacleSet, n: int = 200_000) -> float:
+    u = np.linspace(0.0, curve.knots[-1], n)
+    return float(obstacles.clearances(curve.position(u)).min())
+
+
+def test_interpolates_points_and_keeps_endpoints():
+    pts = np.array([[0.0, 0.0], [2.0, 1.0], [4.0, -1.0], [7.0, 0.5]])
+    c = SmoothCurve(pts)
+    np.testing.assert_allclose(c.position(c.point_u), pts, atol=1e-12)
+    np.testing.assert_allclose(c.position(np.array([0.0, c.knots[-1]])), pts[[0, -1]], atol=1e-12)
+
+
+def test_start_heading_is_kept():
+    pts = np.array([[0.0, 0.0], [2.0, 1.0], [4.0, -1.0]])
+    c = SmoothCurve(pts, start_heading=1.2)
+    assert c.heading(np.array([0.0]))[0] == pytest.approx(1.2, abs=1e-12)
+    # natural end: zero curvature at the end
+    k, _ = c.curvature(np.array([c.knots[-1]]))
+    assert abs(k[0]) < 1e-9
+
+
+def test_parameter_is_close_to_arc_length_and_length_is_exact():
+    pts = np.array([[0.0, 0.0], [3.0, 2.0], [5.0, -1.0], [9.0, 0.0]])
+    c = SmoothCurve(pts)
+    # reference arc length by a very fine polyline
+    u = np.linspace(0.0, c.knots[-1], 400_001)
+    p = c.position(u)
+    ref = float(np.sum(np.hypot(*np.diff(p, axis=0).T)))
+    assert c.length == pytest.approx(ref, rel=1e-8)
+    # |r'(u)| = 1: parameterised by arc length
+    sp = np.hypot(*c.derivatives(u[::100])[0].T)
+    assert np.max(np.abs(sp - 1.0)) < 1e-3
+    # u_of_s inverts s(u)
+    s = np.linspace(0.0, c.length, 101)
+    uu = c.u_of_s(s)
+    q = c.position(np.linspace(0, uu[37], 100001))
+    assert float(np.sum(np.hypot(*np.diff(q, axis=0).T))) == pytest.approx(s[37], abs=1e-6)
+
+
+def test_two_points_give_a_straight_line():
+    c = SmoothCurve(np.array([[1.0, 1.0], [4.0, 5.0]]))
+    k, dk = c.curvature(np.linspace(0.0, c.knots[-1], 50))
+    assert np.max(np.abs(k)) < 1e-9 and np.max(np.abs(dk)) < 1e-8
+    assert c.length == pytest.approx(5.0, rel=1e-12)
+
+
+def test_clean_path_drops_duplicates_and_collinear_points():
+    p = np.array([[0.0, 0.0], [0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 1.0]])
+    np.testing.assert_allclose(clean_path(p), [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0]])
+    with pytest.raises(ValueError):
+        SmoothCurve(np.array([[0.0, 0.0]]))
+
+
+@pytest.mark.parametrize("seed", range(25))
+def test_certification_never_misses_a_contact(seed):
+    rng = np.random.default_rng(seed)
+    pts = np.cumsum(rng.uniform(-1.0, 2.0, (5, 2)), axis=0)
+    c = SmoothCurve(pts, start_heading=float(rng.uniform(-np.pi, np.pi)) if seed % 2 else None)
+    shapes = [Circle(rng.uniform(pts.min(0), pts.max(0)), float(rng.uniform(0.1, 0.6))) for _ in range(3)]
+    shapes.append(rectangle(rng.uniform(pts.min(0), pts.max(0)), (0.5, 0.3), float(rng.uniform(0, 3))))
+    obs = ObstacleSet(shapes)
+    true_min = dense_min_clearance(c, obs)
+    for radius in (0.05, 0.2, 0.4, true_min - 1e-4, true_min + 1e-4):
+        if radius <= 0.0:
+            continue
+        free, bad, margin = curve_clearance_ok(c, obs, radius)
+        if free:
+            assert true_min >= radius - 1e-9
+            assert margin <= true_min - radius + 1e-9
+        if true_min < radius - 1e-6:
+            assert not free and len(bad) > 0
+
+
+def test_certification_is_nearly_tight():
+    # A curve 1 mm clear of an obstacle is certified free with 0.5 mm to spare.
+    c = SmoothCurve(np.array([[0.0, 0.0], [3.0, 1.0], [6.0, 0.0]]))
+    obs = ObstacleSet([Circle((3.0, 2.0), 0.5)])
+    true_min = dense_min_clearance(c, obs)
+    assert curve_clearance_ok(c, obs, true_min - 0.0005)[0]
+
+
+def test_repair_corner_hugging_path():
+    # The polyline keeps only 2 cm of slack along an obstacle that runs into a corner; the first
+    # spline swings out of the corner and cuts it; repair pulls it back.
+    r = 0.3
+    path = np.array([[1.0, 4.0], [5.0, 2.0], [9.0, 4.0]])
+    d = (path[1] - path[0]) / np.hypot(*(path[1] - path[0]))
+    n = np.array([d[1], -d[0]])  # below the first segment, outside the corner
+    ang = math.atan2(d[1], d[0])
+    box = rectangle((3.0, 3.0) + n * (r + 0.02 + 0.25), (3.0, 0.5), ang)
+    obs = ObstacleSet([box], bounds=(0.0, 0.0, 10.0, 6.0))
+    assert obs.path_free(path, r)
+    assert obs.segment_clearance(path[0], path[1]) == pytest.approx(r + 0.02, abs=1e-9)
+    assert obs.path_free(path, r)
+    first = SmoothCurve(clean_path(path))
+    assert not curve_clearance_ok(first, obs, r)[0]
+    res = smooth_path(path, obs, r)
+    assert res.curve is not None and res.rounds > 0 and res.points_added > 0
+    assert dense_min_clearance(res.curve, obs) >= r - 1e-9
+    np.testing.assert_allclose(res.curve.position(res.curve.knots[[0, -1]]), path[[0, -1]], atol=1e-12)
+
+
+def test_random_worlds_are_repaired_and_certified(world_factory):
+    for seed in range(8):
+        obs, path, spec = world_factory(seed)
+        res = smooth_path(path, obs, spec.radius, start_heading=spec.start[2])
+        assert res.curve is not None, seed
+        assert dense_min_clearance(res.curve, obs, 100_000) >= spec.radius - 1e-9
