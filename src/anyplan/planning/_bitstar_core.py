@@ -6,12 +6,14 @@ functions mutate them in place. Layout:
 ``P`` (C, 2) float: point positions [m]. Index 0 is the start, 1 the goal.
 ``F`` (C, 3) float: ``g_hat`` (distance to start), ``h_hat`` (distance to goal), ``g_T``
     (cost-to-come in the tree; inf for a sample).
-``IT`` (C, 6) int: parent, first child, next sibling, previous sibling, batch in which the
-    vertex was last expanded, flags (bit 0: vertex, bit 1: vertex already at batch start).
+``IT`` (C, 7) int: parent, first child, next sibling, previous sibling, batch in which the
+    vertex was last expanded, flags (bit 0: vertex, bit 1: vertex already at batch start),
+    batch in which the point became a sample (new samples are those of the current batch).
 ``vk``/``vp``: vertex queue (binary min-heap keyed ``g_T(v) + h_hat(v)``), payload vp[:, 0].
 ``ek``/``ep``: edge queue (binary min-heap keyed ``g_T(v) + c_hat(v, x) + h_hat(x)``), payload
     (v, x).
-``cstart``/``citems``: uniform grid of cell size r over the points (neighbour queries).
+``cstart``/``citems``: uniform grid of cell size r over all points (neighbour queries);
+    ``nstart``/``nitems``: the same over the new samples only.
 ``S`` float scalars and ``N`` int counters, indexed by the constants below.
 """
 
@@ -30,7 +32,7 @@ N_N, N_VS, N_ES, N_BATCH, N_K, N_CHECKS, N_FAILS, N_EXP, N_REWIRE, N_ITERS, N_QU
     N_NCX, N_NCY = range(13)
 # Column slots.
 G_HAT, H_HAT, G_T = 0, 1, 2
-PAR, FCHILD, NSIB, PSIB, EXPB, FLAGS = 0, 1, 2, 3, 4, 5
+PAR, FCHILD, NSIB, PSIB, EXPB, FLAGS, SBATCH = 0, 1, 2, 3, 4, 5, 6
 F_VERTEX, F_OLD = 1, 2
 # Return codes of iterate().
 RC_BUDGET, RC_BATCH_DONE, RC_IMPROVED, RC_GROW = 0, 1, 2, 3
@@ -87,28 +89,30 @@ def heap_pop(keys: np.ndarray, pay: np.ndarray, size: int) -> int:
 
 # --- grid -------------------------------------------------------------------------------------
 @njit(cache=True)
-def build_grid(P: np.ndarray, n: int, x0: float, y0: float, cell: float, ncx: int,
+def build_grid(P: np.ndarray, idx: np.ndarray, x0: float, y0: float, cell: float, ncx: int,
                ncy: int) -> tuple[np.ndarray, np.ndarray]:
-    """Counting sort of points 0..n-1 into ncx x ncy cells of side ``cell``."""
+    """Counting sort of the points ``idx`` into ncx x ncy cells of side ``cell``."""
+    n = idx.shape[0]
     cstart = np.zeros(ncx * ncy + 1, np.int64)
     cid = np.empty(n, np.int64)
-    for i in range(n):
+    for t in range(n):
+        i = idx[t]
         cx = min(max(int((P[i, 0] - x0) / cell), 0), ncx - 1)
         cy = min(max(int((P[i, 1] - y0) / cell), 0), ncy - 1)
-        cid[i] = cy * ncx + cx
-        cstart[cid[i] + 1] += 1
+        cid[t] = cy * ncx + cx
+        cstart[cid[t] + 1] += 1
     for c in range(ncx * ncy):
         cstart[c + 1] += cstart[c]
     fill = cstart[:-1].copy()
     citems = np.empty(n, np.int64)
-    for i in range(n):
-        citems[fill[cid[i]]] = i
-        fill[cid[i]] += 1
+    for t in range(n):
+        citems[fill[cid[t]]] = idx[t]
+        fill[cid[t]] += 1
     return cstart, citems
 
 
 @njit(cache=True)
-def _near(v: int, P: np.ndarray, n: int, rad: float, cstart: np.ndarray, citems: np.ndarray,
+def _near(v: int, P: np.ndarray, rad: float, cstart: np.ndarray, citems: np.ndarray,
           S: np.ndarray, N: np.ndarray, out: np.ndarray, dout: np.ndarray) -> int:
     """Points within ``rad`` of point v (v excluded) into out/dout; returns their number.
 
@@ -212,25 +216,36 @@ def _shift_subtree(F: np.ndarray, IT: np.ndarray, root: int, delta: float,
 # --- the search ---------------------------------------------------------------------------------
 @njit(cache=True)
 def _expand(v: int, P: np.ndarray, F: np.ndarray, IT: np.ndarray, ek: np.ndarray, ep: np.ndarray,
-            cstart: np.ndarray, citems: np.ndarray, S: np.ndarray, N: np.ndarray,
-            nb: np.ndarray, nd: np.ndarray) -> None:
-    """ExpandVertex(v): queue the edges from v that could improve the solution."""
+            cstart: np.ndarray, citems: np.ndarray, nstart: np.ndarray, nitems: np.ndarray,
+            S: np.ndarray, N: np.ndarray, nb: np.ndarray, nd: np.ndarray) -> None:
+    """ExpandVertex(v): queue the edges from v that could improve the solution.
+
+    A vertex already expanded in an earlier batch has seen every older sample within the
+    (then larger) radius, so only the new samples are considered for it (as OMPL does); a
+    vertex that is new in this batch also gets its rewiring candidates.
+    """
+    is_new = (IT[v, FLAGS] & F_OLD) == 0
+    seen_before = IT[v, EXPB] >= 0 and IT[v, EXPB] < N[N_BATCH]
     IT[v, EXPB] = N[N_BATCH]
     N[N_EXP] += 1
     n = N[N_N]
+    batch = N[N_BATCH]
     if N[N_K] > 0:
         m = _k_nearest(v, P, n, N[N_K], nb, nd)
+    elif seen_before and not is_new:
+        m = _near(v, P, S[S_R], nstart, nitems, S, N, nb, nd)
     else:
-        m = _near(v, P, n, S[S_R], cstart, citems, S, N, nb, nd)
+        m = _near(v, P, S[S_R], cstart, citems, S, N, nb, nd)
     c_best = S[S_CBEST]
     gv = F[v, G_T]
     ghv = F[v, G_HAT]
-    is_new = (IT[v, FLAGS] & F_OLD) == 0
     es = N[N_ES]
     for t in range(m):
         x = nb[t]
         d = nd[t]
         if (IT[x, FLAGS] & F_VERTEX) == 0:
+            if seen_before and not is_new and IT[x, SBATCH] != batch:
+                continue
             # g_hat(v) + c_hat(v, x) + h_hat(x) < c_best ?
             if ghv + d + F[x, H_HAT] < c_best:
                 es = heap_push(ek, ep, es, gv + d + F[x, H_HAT], v, x)
@@ -247,7 +262,8 @@ def _expand(v: int, P: np.ndarray, F: np.ndarray, IT: np.ndarray, ek: np.ndarray
 @njit(cache=True)
 def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np.ndarray,
             ek: np.ndarray, ep: np.ndarray, cstart: np.ndarray, citems: np.ndarray,
-            S: np.ndarray, N: np.ndarray, stack: np.ndarray, nb: np.ndarray, nd: np.ndarray,
+            nstart: np.ndarray, nitems: np.ndarray, S: np.ndarray, N: np.ndarray,
+            stack: np.ndarray, nb: np.ndarray, nd: np.ndarray,
             ovx: np.ndarray, ovy: np.ndarray, ostarts: np.ndarray, opbox: np.ndarray,
             ocircles: np.ndarray, obounds: np.ndarray, max_iter: int) -> int:
     """Run up to ``max_iter`` edge-queue iterations of one batch.
@@ -275,7 +291,7 @@ def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np
             if kv >= c_best:
                 break
             N[N_VS] = heap_pop(vk, vp, N[N_VS])
-            _expand(v, P, F, IT, ek, ep, cstart, citems, S, N, nb, nd)
+            _expand(v, P, F, IT, ek, ep, cstart, citems, nstart, nitems, S, N, nb, nd)
             if ek.shape[0] - N[N_ES] < n + 8:
                 return RC_GROW
         if N[N_ES] == 0:
@@ -328,18 +344,33 @@ def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np
 
 
 @njit(cache=True)
-def start_batch(F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np.ndarray, S: np.ndarray,
-                N: np.ndarray) -> None:
-    """New batch: clear both queues, mark all vertices old and queue them all."""
+def start_batch(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np.ndarray,
+                S: np.ndarray, N: np.ndarray, cstart: np.ndarray, citems: np.ndarray,
+                newidx: np.ndarray, nb: np.ndarray, nd: np.ndarray) -> None:
+    """New batch: clear both queues, mark all vertices old and queue the useful ones.
+
+    A vertex expanded in an earlier batch only needs expanding again if a new sample lies
+    within r of it (its expansion considers new samples only); skipping the others changes
+    nothing but the cost. The grid must be built for this batch.
+    """
     N[N_BATCH] += 1
     N[N_ES] = 0
+    n = N[N_N]
+    near_new = np.zeros(n, np.bool_)
+    if N[N_K] > 0:
+        near_new[:] = True
+    else:
+        for t in range(newidx.shape[0]):
+            m = _near(newidx[t], P, S[S_R], cstart, citems, S, N, nb, nd)
+            for u in range(m):
+                near_new[nb[u]] = True
     vs = 0
     c_best = S[S_CBEST]
-    for i in range(N[N_N]):
+    for i in range(n):
         if (IT[i, FLAGS] & F_VERTEX) != 0:
             IT[i, FLAGS] |= F_OLD
             key = F[i, G_T] + F[i, H_HAT]
-            if key < c_best:
+            if key < c_best and (near_new[i] or IT[i, EXPB] < 0):
                 vs = heap_push(vk, vp, vs, key, i, 0)
     N[N_VS] = vs
 
@@ -397,6 +428,10 @@ def compact(P: np.ndarray, F: np.ndarray, IT: np.ndarray, N: np.ndarray, state: 
             IT[j, FLAGS] = F_VERTEX | (IT[i, FLAGS] & F_OLD)
             IT[j, EXPB] = IT[i, EXPB]
         else:
+            if (IT[i, FLAGS] & F_VERTEX) != 0:
+                IT[j, SBATCH] = N[N_BATCH] + 1  # a recycled vertex is a new sample next batch
+            else:
+                IT[j, SBATCH] = IT[i, SBATCH]
             F[j, G_T] = INF
             IT[j, PAR] = -1
             IT[j, FLAGS] = 0

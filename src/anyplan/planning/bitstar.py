@@ -208,7 +208,7 @@ class BITStar(Planner):
         cap = 1024
         self._P = np.zeros((cap, 2))
         self._F = np.full((cap, 3), math.inf)
-        self._I = np.full((cap, 6), -1, np.int64)
+        self._I = np.full((cap, 7), -1, np.int64)
         self._vk = np.zeros(cap)
         self._vp = np.zeros((cap, 2), np.int64)
         self._ek = np.zeros(4 * cap)
@@ -220,6 +220,8 @@ class BITStar(Planner):
         self._N = np.zeros(16, np.int64)
         self._cstart = np.zeros(2, np.int64)
         self._citems = np.zeros(0, np.int64)
+        self._nstart = np.zeros(2, np.int64)
+        self._nitems = np.zeros(0, np.int64)
         self._S[core.S_CBEST] = math.inf
         self._S[core.S_LIMIT] = self._limit
         # Start (0) and goal (1).
@@ -322,7 +324,7 @@ class BITStar(Planner):
         new = max(need, 2 * cap)
         self._P = np.vstack([self._P, np.zeros((new - cap, 2))])
         self._F = np.vstack([self._F, np.full((new - cap, 3), math.inf)])
-        self._I = np.vstack([self._I, np.full((new - cap, 6), -1, np.int64)])
+        self._I = np.vstack([self._I, np.full((new - cap, 7), -1, np.int64)])
         self._stack = np.zeros(new, np.int64)
         self._nb = np.zeros(new, np.int64)
         self._nd = np.zeros(new)
@@ -371,6 +373,7 @@ class BITStar(Planner):
             self._F[n:n + k, core.G_T] = math.inf
             self._I[n:n + k] = -1
             self._I[n:n + k, core.FLAGS] = 0
+            self._I[n:n + k, core.SBATCH] = self.n_batches + 1
             self._N[core.N_N] = n + k
             self._n_samples_drawn += k
         n = int(self._N[core.N_N])
@@ -394,12 +397,16 @@ class BITStar(Planner):
         self._S[core.S_CELL] = cell
         self._N[core.N_NCX] = ncx
         self._N[core.N_NCY] = ncy
-        self._cstart, self._citems = core.build_grid(self._P, n, xmin, ymin, cell, ncx, ncy)
+        self._cstart, self._citems = core.build_grid(self._P, np.arange(n), xmin, ymin, cell, ncx, ncy)
+        new = np.flatnonzero((self._I[:n, core.SBATCH] == self.n_batches + 1)
+                             & ((self._I[:n, core.FLAGS] & core.F_VERTEX) == 0))
+        self._nstart, self._nitems = core.build_grid(self._P, new, xmin, ymin, cell, ncx, ncy)
         if self._vk.shape[0] < n + 8:
             size = 2 * (n + 8)
             self._vk = np.zeros(size)
             self._vp = np.zeros((size, 2), np.int64)
-        core.start_batch(self._F, self._I, self._vk, self._vp, self._S, self._N)
+        core.start_batch(self._P, self._F, self._I, self._vk, self._vp, self._S, self._N,
+                         self._cstart, self._citems, new, self._nb, self._nd)
         self._batch_open = True
 
     # --- solve --------------------------------------------------------------------------------------
@@ -442,8 +449,8 @@ class BITStar(Planner):
                 continue
             tc = time.perf_counter()
             rc = core.iterate(self._P, self._F, self._I, self._vk, self._vp, self._ek, self._ep,
-                              self._cstart, self._citems, self._S, self._N, self._stack, self._nb,
-                              self._nd, *obs_args, self._chunk)
+                              self._cstart, self._citems, self._nstart, self._nitems, self._S,
+                              self._N, self._stack, self._nb, self._nd, *obs_args, self._chunk)
             dt = time.perf_counter() - tc
             if rc == core.RC_BUDGET:
                 # Adapt the chunk so that ptc() is polled about every chunk_s seconds.
