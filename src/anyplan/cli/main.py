@@ -24,6 +24,7 @@ __all__ = ["main", "COMMAND_MODULES", "UsageError"]
 COMMAND_MODULES = [
     "anyplan.cli.cmd_run",
     "anyplan.cli.cmd_bench",
+    "anyplan.cli.cmd_dynabarn",
 ]
 
 
