@@ -10,6 +10,7 @@ from anyplan.trajectory.spline import (
     SmoothingResult,
     clean_path,
     curve_clearance_ok,
+    shortcut_path,
     smooth_path,
 )
 from anyplan.trajectory.trajectory import (
@@ -36,6 +37,7 @@ __all__ = [
     "plan_motion",
     "polyline_trajectory",
     "rotation_profile",
+    "shortcut_path",
     "smooth_path",
     "time_lower_bound",
     "time_parameterize",

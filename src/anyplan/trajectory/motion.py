@@ -24,7 +24,7 @@ import numpy as np
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.geometry.se2 import wrap_angle
 from anyplan.trajectory.profile import time_lower_bound, time_parameterize
-from anyplan.trajectory.spline import SmoothCurve, clean_path, smooth_path
+from anyplan.trajectory.spline import SmoothCurve, clean_path, shortcut_path, smooth_path
 from anyplan.trajectory.trajectory import (
     BrakeSegment,
     CurveSegment,
@@ -119,7 +119,8 @@ def polyline_trajectory(path: np.ndarray, spec: RobotSpec, state: RobotState, t_
 
 def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles: ObstacleSet,
                 t_start: float, *, margin: float = 0.0, grid_step: float = 0.02,
-                max_repair_rounds: int = 10, allow_turn: bool = True) -> Trajectory:
+                max_repair_rounds: int = 10, allow_turn: bool = True, shortcut: bool = True,
+                shortcut_slack: float = 0.01) -> Trajectory:
     """Turn a planned polyline into a timed, collision-free reference motion.
 
     Args:
@@ -134,12 +135,21 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         grid_step: Grid spacing [m] of the speed profile and the collision certification.
         max_repair_rounds: Spline repair rounds before the polyline fallback.
         allow_turn: Consider turning in place (disable to force the smooth start).
+        shortcut: First drop the path's vertices that a straight segment can skip
+            (:func:`~anyplan.trajectory.spline.shortcut_path`); the new segments keep a clearance
+            of ``spec.radius + margin + shortcut_slack``. ``obstacles`` must then contain every
+            obstacle the path avoids (virtual ones included).
+        shortcut_slack: Extra clearance [m] of shortcut segments, left for the spline to round
+            the corners in.
 
     Returns:
         The fastest admissible :class:`Trajectory`; ``info`` lists the candidate durations.
     """
     radius = spec.radius + margin
     pts = clean_path(path)
+    n_input = len(pts)
+    if shortcut:
+        pts = shortcut_path(pts, obstacles, radius + shortcut_slack)
     p0 = np.array([state.x, state.y])
     d0 = math.hypot(*(pts[0] - p0))
     if d0 <= 0.05:
@@ -158,7 +168,7 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         return Trajectory([seg], kind="hold", lower_bound_s=0.0, polyline=pts)
     v0 = max(state.v, 0.0)
     cands: list[tuple[bool, float, Trajectory]] = []
-    info: dict = {"candidates": {}}
+    info: dict = {"candidates": {}, "input_vertices": n_input, "vertices": len(pts)}
 
     # A. smooth start along the current heading, at the current speed.
     res = smooth_path(pts, obstacles, radius, start_heading=state.theta, max_rounds=max_repair_rounds,

@@ -38,7 +38,14 @@ from scipy.interpolate import CubicSpline
 
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 
-__all__ = ["SmoothCurve", "SmoothingResult", "clean_path", "curve_clearance_ok", "smooth_path"]
+__all__ = [
+    "SmoothCurve",
+    "SmoothingResult",
+    "clean_path",
+    "curve_clearance_ok",
+    "shortcut_path",
+    "smooth_path",
+]
 
 # Gauss-Legendre nodes/weights on [0, 1] (5 points: exact for polynomials of degree 9).
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(5)
@@ -83,6 +90,42 @@ def clean_path(path: np.ndarray, tol: float = 1e-9, collinear_tol: float = 1e-9)
     if len(keep) > 1:
         out.append(keep[-1])
     return np.array(out)
+
+
+def shortcut_path(path: np.ndarray, obstacles: ObstacleSet, radius: float) -> np.ndarray:
+    """Drop vertices greedily: from each kept vertex jump to the farthest one in straight sight.
+
+    Sampling planners return many jittery vertices (BIT* at a fixed budget: one every few
+    centimetres, off the straight line by millimetres); a spline through all of them wiggles
+    with a curvature that forces the robot to crawl. A vertex is skipped only when the straight
+    segment that replaces it keeps a clearance of at least ``radius`` [m] (exact test), so the
+    result is never longer and stays free for a disc of ``radius``. Segments of the input that
+    are not free at ``radius`` are kept as they are.
+
+    Args:
+        path: Polyline (N, 2) [m].
+        obstacles: Obstacles (all that the path must avoid, virtual ones included).
+        radius: Clearance [m] every new segment must keep.
+
+    Returns:
+        A subsequence of ``path`` with the same first and last points.
+    """
+    p = np.asarray(path, dtype=float).reshape(-1, 2)
+    if len(p) <= 2:
+        return p.copy()
+    keep = [0]
+    i, n = 0, len(p)
+    limit = radius - COLLISION_EPS
+    while i < n - 1:
+        js = np.arange(i + 2, n)
+        nxt = i + 1
+        if len(js):
+            ok = obstacles.segments_clearance(np.repeat(p[i:i + 1], len(js), axis=0), p[js]) >= limit
+            if np.any(ok):
+                nxt = int(js[np.nonzero(ok)[0][-1]])
+        keep.append(nxt)
+        i = nxt
+    return p[keep]
 
 
 class SmoothCurve:

@@ -1,0 +1,146 @@
+"""The ``bitstar`` agent: plan once with BIT* among the static obstacles, then drive.
+
+The static part of the method of Roy, Harchowdhury & Vachhani ("Anytime Planning: A Motion
+Planner for Dynamic Environment", §4): BIT* (Gammell, Srinivasa & Barfoot 2015) plans a shortest
+path among the static obstacles; the path is smoothed with a cubic spline and given a reference
+motion within the robot's limits (:func:`anyplan.trajectory.plan_motion`); Kanayama's tracking
+law follows it (:mod:`anyplan.control`). Moving obstacles are ignored: this agent is the baseline
+that shows what Sequential BIT* adds.
+
+Clearance margins: BIT* plans for a disc ``plan_margin`` larger than the robot, the smoothed curve
+must keep ``smooth_margin`` (< plan_margin) beyond the robot radius, and the tracking error (a few
+micrometres in simulation) must stay below ``smooth_margin``. The slack between the two margins is
+what lets the spline round the corners of BIT*'s path without cutting into an obstacle.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from anyplan.agents.base import Agent, Observation
+from anyplan.control.kanayama import KanayamaController, KanayamaGains
+from anyplan.trajectory.motion import plan_motion
+from anyplan.trajectory.trajectory import Trajectory
+from anyplan.world.robot import Command, RobotState
+from anyplan.world.scenario import Scenario
+
+__all__ = ["BITStarAgent"]
+
+
+class BITStarAgent(Agent):
+    """Plan once with BIT*, smooth, profile and track.
+
+    Args:
+        time_budget_s: Wall-clock budget [s] of the BIT* call.
+        plan_margin: Extra clearance [m] added to the robot radius for BIT*.
+        smooth_margin: Extra clearance [m] the smoothed curve must keep.
+        max_attempts: BIT* calls (each with twice the previous budget) before giving up.
+        gains: Kanayama gains (defaults: :class:`~anyplan.control.KanayamaGains`).
+        control_dt: Control period [s] assumed before the second observation reveals it.
+    """
+
+    name = "bitstar"
+
+    def __init__(self, time_budget_s: float = 0.5, plan_margin: float = 0.03,
+                 smooth_margin: float = 0.015, max_attempts: int = 3,
+                 gains: KanayamaGains | None = None, control_dt: float = 0.05) -> None:
+        super().__init__()
+        if not time_budget_s > 0.0:
+            raise ValueError(f"time_budget_s must be > 0 s, got {time_budget_s}")
+        if not 0.0 <= smooth_margin <= plan_margin:
+            raise ValueError("smooth_margin must be in [0, plan_margin]")
+        if max_attempts < 1:
+            raise ValueError(f"max_attempts must be >= 1, got {max_attempts}")
+        self.time_budget_s = float(time_budget_s)
+        self.plan_margin = float(plan_margin)
+        self.smooth_margin = float(smooth_margin)
+        self.max_attempts = int(max_attempts)
+        self.gains = gains or KanayamaGains()
+        self.control_dt = float(control_dt)
+        self.trajectory: Trajectory | None = None
+
+    def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
+        from anyplan.agents.base import AgentStats
+
+        self.stats = AgentStats()
+        self.scenario = scenario
+        self.spec = scenario.robot
+        self.obstacles = scenario.obstacle_set()
+        self.rng = rng
+        self.trajectory = None
+        self.failed = False
+        self.controller = KanayamaController(self.spec, self.gains, self.control_dt)
+        self._last_t: float | None = None
+        self._err_sq = 0.0
+        self._err_n = 0
+        self._err_max = 0.0
+
+    # --- planning -----------------------------------------------------------------------------
+    def _plan(self, obs: Observation) -> None:
+        from anyplan.planning import plan
+
+        spec, r = self.spec, obs.robot
+        start = (r.x, r.y)
+        # Keep the margin only where the start allows it (a start hugging an obstacle).
+        margin = min(self.plan_margin, max(self.obstacles.clearance(start) - spec.radius, 0.0))
+        smooth_margin = min(self.smooth_margin, margin)
+        t0 = time.perf_counter()
+        budget = self.time_budget_s
+        res = None
+        for _ in range(self.max_attempts):
+            res = plan(self.obstacles, start, spec.goal, spec.radius + margin, planner="bitstar",
+                       time_budget_s=budget, rng=self.rng)
+            if res.solved:
+                break
+            budget *= 2.0
+        t1 = time.perf_counter()
+        if res is None or not res.solved:
+            self.stats.planning_times_s.append(t1 - t0)
+            self.failed = True
+            self.stats.extra["plan_status"] = None if res is None else res.status.value
+            return
+        path = np.asarray(res.path, dtype=float)
+        traj = plan_motion(path, spec, r, self.obstacles, obs.t, margin=smooth_margin)
+        t2 = time.perf_counter()
+        self.trajectory = traj
+        self.stats.planning_times_s.append(t2 - t0)
+        self.stats.plans.append({"t": obs.t, "path": path.tolist()})
+        self.stats.extra.update({
+            "plan_status": res.status.value,
+            "bitstar_time_s": t1 - t0,
+            "motion_time_s": t2 - t1,
+            "path_cost_m": float(res.cost),
+            "trajectory_kind": traj.kind,
+            "smoothed_length_m": traj.length,
+            "reference_duration_s": traj.duration,
+            "time_lower_bound_s": traj.lower_bound_s,
+            "smoothed_path": traj.path[:: max(1, len(traj.path) // 400)].tolist(),
+        })
+
+    # --- control ------------------------------------------------------------------------------
+    def act(self, obs: Observation) -> Command:
+        if self._last_t is not None and obs.t > self._last_t:
+            self.controller.dt = obs.t - self._last_t
+        self._last_t = obs.t
+        if self.trajectory is None and not self.failed:
+            self._plan(obs)
+        traj = self.trajectory
+        if traj is None:
+            return Command(0.0, 0.0)
+        x, y, _, _, _ = traj.state(obs.t)
+        err = math.hypot(x - obs.robot.x, y - obs.robot.y)
+        self._err_sq += err * err
+        self._err_n += 1
+        self._err_max = max(self._err_max, err)
+        self.stats.extra["tracking_rms_m"] = math.sqrt(self._err_sq / self._err_n)
+        self.stats.extra["tracking_max_m"] = self._err_max
+        return self.controller.command(traj, obs.robot, obs.t)
+
+    def reference_state(self, t: float) -> RobotState | None:
+        """The reference state at time ``t`` [s], or None before planning."""
+        if self.trajectory is None:
+            return None
+        return RobotState(*self.trajectory.state(t))
