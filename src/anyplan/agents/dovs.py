@@ -1,0 +1,102 @@
+"""The ``dovs`` planner: DOVS-Greedy (Lorente, Owen & Montano, IJRR 2018) as a simulator agent.
+
+Every control period T (``control_period_s``, default 0.2 s, i.e. every 4th simulator step of
+0.05 s) the agent builds the DOVS from the observed moving obstacles (pose and twist, assumed
+constant) and the static map given at reset, picks a command with the greedy selector and holds
+it until the next period. ``stats.planning_times_s`` holds the wall-clock time of each period's
+computation; ``stats.extra`` counts how often each selection mode and goal target was used.
+
+By default the robot limits (v_max, omega_max, a_max, alpha_max, radius) are taken from the
+scenario's robot, so that the dynamic window never asks for more than the robot can do; for
+the built-in paper scenarios they equal the paper's Table 1 values, the defaults of
+:class:`~anyplan.baselines.dovs.config.DOVSConfig`.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from dataclasses import asdict, replace
+from typing import Any
+
+import numpy as np
+
+from anyplan.agents.base import Agent, Observation
+from anyplan.baselines.dovs.config import DOVSConfig, DOVSConfigError
+from anyplan.baselines.dovs.model import StaticMap
+from anyplan.baselines.dovs.planner import Decision, DOVSPlanner
+from anyplan.world.robot import Command
+from anyplan.world.scenario import Scenario
+
+__all__ = ["DOVSAgent"]
+
+
+class DOVSAgent(Agent):
+    """DOVS-Greedy: recompute every ``control_period_s`` and hold the command in between.
+
+    Args:
+        config: A :class:`DOVSConfig`; keyword arguments override its fields.
+        use_robot_limits: Take v_max, omega_max, a_v, a_omega and robot_radius from the
+            scenario's robot at reset (default True).
+        **overrides: Any :class:`DOVSConfig` field.
+
+    Raises:
+        DOVSConfigError: An unknown parameter name or an invalid value.
+    """
+
+    name = "dovs"
+
+    def __init__(self, config: DOVSConfig | None = None, use_robot_limits: bool = True,
+                 **overrides: Any) -> None:
+        super().__init__()
+        base = config or DOVSConfig()
+        unknown = sorted(set(overrides) - set(DOVSConfig.field_names()))
+        if unknown:
+            raise DOVSConfigError(f"dovs: unknown parameter(s) {', '.join(unknown)} "
+                                  f"(known: {', '.join(DOVSConfig.field_names())})")
+        self.base_config = replace(base, **overrides) if overrides else base
+        self.use_robot_limits = use_robot_limits
+        self.config = self.base_config
+        self.planner: DOVSPlanner | None = None
+        self.last_decision: Decision | None = None
+
+    def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
+        spec = scenario.robot
+        cfg = self.base_config
+        if self.use_robot_limits:
+            cfg = replace(cfg, v_max=spec.v_max, omega_max=spec.omega_max, a_v=spec.a_max,
+                          a_omega=spec.alpha_max, robot_radius=spec.radius)
+        self.config = cfg
+        static = StaticMap([o.shape for o in scenario.static_obstacles], scenario.bounds, cfg)
+        self.planner = DOVSPlanner(cfg, spec.goal, static)
+        self.last_decision = None
+        self._next_t: float | None = None
+        self._held = Command(0.0, 0.0)
+        self._modes: Counter[str] = Counter()
+        self._targets: Counter[str] = Counter()
+        self.stats.planning_times_s.clear()
+        self.stats.extra.clear()
+        self.stats.extra.update({"control_period_s": cfg.control_period_s,
+                                 "dovs_config": asdict(cfg)})
+
+    def decide(self, obs: Observation) -> Decision:
+        """Run one DOVS period on ``obs`` (does not change the held command or the stats)."""
+        if self.planner is None:
+            raise RuntimeError("DOVSAgent.decide called before reset")
+        r = obs.robot
+        return self.planner.decide((r.x, r.y, r.theta), (r.v, r.omega), obs.obstacles)
+
+    def act(self, obs: Observation) -> Command:
+        if self._next_t is not None and obs.t < self._next_t - 1e-9:
+            return self._held
+        t0 = time.perf_counter()
+        d = self.decide(obs)
+        self.stats.planning_times_s.append(time.perf_counter() - t0)
+        self.last_decision = d
+        self._held = Command(d.selection.v, d.selection.omega)
+        self._next_t = obs.t + self.config.control_period_s
+        self._modes[d.selection.mode] += 1
+        self._targets[d.goal.mode] += 1
+        self.stats.extra["selection_modes"] = dict(self._modes)
+        self.stats.extra["goal_targets"] = dict(self._targets)
+        return self._held
