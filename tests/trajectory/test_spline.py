@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from anyplan.geometry import Circle, ObstacleSet, rectangle
-from anyplan.trajectory import SmoothCurve, clean_path, curve_clearance_ok, smooth_path
+from anyplan.trajectory import SmoothCurve, clean_path, curve_clearance_ok, shortcut_path, smooth_path
 
 
 def dense_min_clearance(curve: SmoothCurve, obstacles: ObstacleSet, n: int = 200_000) -> float:
@@ -119,3 +119,22 @@ def test_random_worlds_are_repaired_and_certified(world_factory):
         res = smooth_path(path, obs, spec.radius, start_heading=spec.start[2])
         assert res.curve is not None, seed
         assert dense_min_clearance(res.curve, obs, 100_000) >= spec.radius - 1e-9
+
+
+def test_shortcut_removes_jitter_and_keeps_clearance():
+    rng = np.random.default_rng(3)
+    obs = ObstacleSet([Circle((5.0, 3.0), 1.0)], bounds=(0.0, 0.0, 10.0, 6.0))
+    # a jittery detour over the circle, as a sampling planner returns it
+    t = np.linspace(0.0, 1.0, 120)
+    base = np.column_stack([1.0 + 8.0 * t, 3.0 + 1.6 * np.sin(np.pi * t)])
+    path = base + rng.normal(0.0, 0.003, base.shape)
+    path[0], path[-1] = base[0], base[-1]
+    assert obs.path_free(path, 0.3)
+    out = shortcut_path(path, obs, 0.3)
+    assert len(out) < 10
+    np.testing.assert_allclose(out[[0, -1]], path[[0, -1]])
+    assert obs.path_free(out, 0.3)
+    length = lambda p: float(np.sum(np.hypot(*np.diff(p, axis=0).T)))  # noqa: E731
+    assert length(out) < length(path)
+    # every kept point is a vertex of the input
+    assert all(np.any(np.all(path == q, axis=1)) for q in out)
