@@ -256,6 +256,10 @@ def _expand(v: int, P: np.ndarray, F: np.ndarray, IT: np.ndarray, ek: np.ndarray
               and ghv + d + F[x, H_HAT] < c_best and gv + d < F[x, G_T]):
             es = heap_push(ek, ep, es, gv + d + F[x, H_HAT], v, x)
             N[N_QUEUED] += 1
+    if v == 0 and (IT[1, FLAGS] & F_VERTEX) == 0 and F[1, G_HAT] > S[S_R]:
+        # Always try the direct start-goal edge, the best possible one, even beyond r.
+        es = heap_push(ek, ep, es, F[1, G_HAT], 0, 1)
+        N[N_QUEUED] += 1
     N[N_ES] = es
 
 
