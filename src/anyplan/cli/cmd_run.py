@@ -27,6 +27,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--time-limit", type=float, default=None,
                    help="simulated time limit [s] (default: the scenario's)")
     p.add_argument("--no-plot", action="store_true", help="do not write run.png")
+    p.add_argument("--animate", default=None, metavar="FILE",
+                   help="also write an animation of the run (.gif, or .mp4 when ffmpeg is present)")
+    p.add_argument("--speed", type=float, default=4.0,
+                   help="animation playback speed, x real time (default 4)")
     p.set_defaults(func=cmd_run)
 
     s = sub.add_parser("scenarios", help="list the built-in scenarios")
@@ -55,6 +59,13 @@ def cmd_run(args: argparse.Namespace) -> int:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise UsageError(f"run: --out {out}: cannot create folder ({exc.strerror})") from None
+    if args.animate:  # check the target before simulating
+        from anyplan.viz.animation import check_target
+
+        try:
+            check_target(args.animate, args.speed)
+        except ValueError as exc:
+            raise UsageError(f"run: --animate: {exc}") from None
     result = simulate(scenario, make_agent(args.planner), seed=args.seed, config=cfg)
     (out / "result.json").write_text(json.dumps(result.to_dict(), indent=1))
     if not args.no_plot:
@@ -62,6 +73,10 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         save_run_figure(scenario, result, out / "run.png")
     print(summary(result, out))
+    if args.animate:
+        from anyplan.viz.animation import animate_run
+
+        print(f"  animation      {animate_run(scenario, result, args.animate, speed=args.speed)}")
     return 0
 
 
