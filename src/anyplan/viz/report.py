@@ -159,6 +159,11 @@ def boxplots(db: ResultsDB, path: str | Path) -> Path | None:
                            boxprops={"facecolor": color, "alpha": 0.45, "edgecolor": color},
                            medianprops={"color": "black"}, whiskerprops={"color": color},
                            capprops={"color": color}, flierprops={"markeredgecolor": color})
+                # Every run as a dot (boxes of identical values collapse to a line).
+                jitter = np.random.default_rng(k).uniform(-0.25, 0.25, size=sum(len(d) for d in data))
+                xs = np.concatenate([np.full(len(d), x) for d, x in zip(data, pos, strict=True)])
+                ax.scatter(xs + jitter * width, np.concatenate(data), s=9, color=color, alpha=0.7,
+                           zorder=3, lw=0)
                 drawn = True
             ax.plot([], [], "s", color=PLANNER_COLORS[k % len(PLANNER_COLORS)], alpha=0.6, label=planner)
         ax.set_xticks(range(len(ns)))
@@ -225,7 +230,8 @@ def cost_time_figure(db: ResultsDB, path: str | Path) -> Path | None:
             tmax = max(float(t[-1]) for t, _ in curves)
             tmin = min(float(t[0]) for t, _ in curves)
             for t, c in curves[:30]:
-                ax.step(t, c, where="post", color=color, alpha=0.15, lw=0.8)
+                ax.step(t, c, where="post", color=color, alpha=0.25 if anytime else 0.5, lw=0.8,
+                        marker="" if anytime and len(t) > 20 else "o", ms=3)
             if anytime and tmax > tmin:
                 grid = np.linspace(tmin, tmax, 200)
                 med, lo, hi = _step_median(curves, grid)
