@@ -79,12 +79,7 @@ def warm_up() -> float:
     t0 = time.perf_counter()
     obs = ObstacleSet([Circle((2.0, 2.0), 0.5)], bounds=(0.0, 0.0, 4.0, 4.0))
     p = BITStar(Problem.create(obs, (0.5, 0.5), (3.5, 3.5), 0.1), rng=0, samples_per_batch=30)
-    p.solve(batches(3))
-    p.add_obstacles([Circle((1.0, 3.0), 0.3)])
-    p.solve(batches(1))
-    p = BITStar(Problem.create(obs, (0.5, 0.5), (3.5, 3.5), 0.1), rng=0, samples_per_batch=30,
-                use_k_nearest=True)
-    p.solve(batches(2))
+    p.solve(batches(2))  # iterate, start_batch, build_grid, compact (prune), sampling
     dt = time.perf_counter() - t0
     logger.debug("BIT* kernels ready in %.3f s", dt)
     return dt

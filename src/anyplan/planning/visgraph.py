@@ -35,8 +35,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import dijkstra
 
 from anyplan.geometry import _kernels as gk
 from anyplan.geometry.shapes import Circle, Polygon
@@ -410,6 +408,9 @@ def shortest_path(problem: Problem, *, variant: str = "feasible",
     ei, ej, w = _edges(np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), prv, nxt,
                        2, exact, problem.check_radius, starts, box, nx, ny, off,
                        ovx, ovy, ost, opb, oci, obd)
+    from scipy.sparse import coo_matrix  # lazy: keeps `import anyplan.planning` light
+    from scipy.sparse.csgraph import dijkstra
+
     n = len(pts)
     # The "lower" variant needs no wall test in _edges: both ends lie in the shrunk box, which
     # is convex, so the whole segment does too.

@@ -1,0 +1,72 @@
+"""``anyplan plan``: plan start -> goal among a scenario's static obstacles."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+from anyplan.planning.api import PLANNERS
+
+DEFAULT_TIME_S = 1.0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the ``plan`` sub-command."""
+    p = sub.add_parser("plan", help="plan a path among a scenario's static obstacles",
+                       description="Plan start -> goal for the scenario's robot (a disc) among its "
+                       "static obstacles; prints a summary and optionally writes JSON and a plot.")
+    p.add_argument("scenario", help="built-in scenario name (see 'anyplan scenarios') or YAML file")
+    p.add_argument("--planner", default="bitstar", choices=PLANNERS,
+                   help="planner (default bitstar)")
+    p.add_argument("--time", type=float, default=DEFAULT_TIME_S,
+                   help=f"time budget [s] for BIT* (default {DEFAULT_TIME_S})")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--json", default=None, metavar="FILE", help="write the result as JSON")
+    p.add_argument("--plot", default=None, metavar="FILE",
+                   help="write a picture (tree, samples, informed ellipse, path)")
+    p.set_defaults(func=cmd_plan)
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    """Run one planning query; exit code 0 if a path was found, 1 otherwise."""
+    from anyplan.cli.main import UsageError
+    from anyplan.planning import Problem, make_planner, timed
+    from anyplan.planning.visgraph import lower_bound
+    from anyplan.world.scenario import load_scenario
+
+    if not (math.isfinite(args.time) and args.time > 0.0):
+        raise UsageError(f"plan: --time must be > 0 seconds, got {args.time}")
+    for opt in ("json", "plot"):
+        target = getattr(args, opt)
+        if target is not None and not Path(target).parent.exists():
+            raise UsageError(f"plan: --{opt} {target}: folder {Path(target).parent} does not exist")
+    scenario = load_scenario(args.scenario)
+    r = scenario.robot
+    problem = Problem.create(scenario.obstacle_set(), r.start[:2], r.goal, r.radius)
+    planner = make_planner(args.planner, problem, rng=args.seed)
+    planner.solve(timed(args.time))
+    result = planner.result()
+    if result.lower_bound is None and problem.start_valid() and problem.goal_valid():
+        lb = lower_bound(problem)
+        result.lower_bound = lb if math.isfinite(lb) else None
+    out = {k: v for k, v in result.to_dict().items() if k not in ("planner", "stats")}
+    if args.json:
+        doc = {**out, "planner": result.planner, "scenario": scenario.name, "seed": args.seed,
+               "time_budget_s": args.time, "stats": result.stats}
+        Path(args.json).write_text(json.dumps(doc, indent=1))
+    if args.plot:
+        from anyplan.viz.planner import save_planner_figure
+
+        data = planner.planner_data() if hasattr(planner, "planner_data") else None
+        save_planner_figure(problem, result, args.plot, data)
+    lb = result.lower_bound
+    ratio = f" ({result.cost / lb:.4f} x lower bound {lb:.3f} m)" if lb and result.solved else ""
+    first = ("-" if result.first_solution_time_s is None
+             else f"{1e3 * result.first_solution_time_s:.2f} ms")
+    print(f"{scenario.name} / {result.planner} / seed {args.seed}: {result.status.value}")
+    print(f"  cost            {result.cost:.4f} m{ratio}")
+    print(f"  first solution  {first}; solve time {result.solve_time_s:.3f} s")
+    print(f"  waypoints       {len(result.path)}")
+    return 0 if result.solved else 1
