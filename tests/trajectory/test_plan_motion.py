@@ -125,3 +125,25 @@ def test_already_at_goal_holds():
     spec = load_scenario("paper-1").robot
     tr = plan_motion(np.array([[3.0, 3.0]]), spec, RobotState(3.0, 3.0, 0.0), ObstacleSet(), 0.0)
     assert tr.kind == "hold" and tr.length == 0.0
+
+
+@pytest.mark.parametrize("v0", [0.0, 0.2, 0.4])
+def test_facing_a_wall_brakes_and_turns(v0, limits_checker):
+    # Heading into a wall 0.6 m away: a smooth start would have to loop through the wall.
+    spec = load_scenario("paper-1").robot
+    obs = ObstacleSet([], bounds=(0.0, 0.0, 10.0, 6.0))
+    tr = plan_motion(np.array([[0.9, 3.0], [9.0, 3.0]]), spec, RobotState(0.9, 3.0, math.pi, v0, 0.0),
+                     obs, 0.0)
+    assert tr.kind == ("turn+smooth" if v0 == 0.0 else "brake+turn+smooth")
+    assert "smooth" not in tr.info["candidates"]
+    limits_checker(tr, spec)
+    assert dense_clearance(tr, obs) >= spec.radius - 1e-9
+    assert tr.certified_free and tr.feasible
+
+
+def test_colliding_input_is_reported():
+    spec = load_scenario("paper-1").robot
+    obs = ObstacleSet([Circle((5.0, 3.0), 0.5)], bounds=(0.0, 0.0, 10.0, 6.0))
+    tr = plan_motion(np.array([[1.0, 3.0], [9.0, 3.0]]), spec, RobotState(1.0, 3.0, 0.0), obs, 0.0,
+                     max_repair_rounds=2)
+    assert tr.kind == "polyline" and not tr.certified_free

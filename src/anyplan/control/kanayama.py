@@ -36,6 +36,11 @@ Kanayama's (K_x = 10, K_y = 64, K_theta = 16 in SI units): our robot's omega_max
 alpha_max = 1 rad/s^2 are so low that stiffer gains only saturate and make the corrections
 bang-bang; and with dt = 0.05 s, K_x dt and w_n dt stay far below the discrete stability limit 2.
 K_turn = 2 1/s: heading errors while turning in place decay in ~0.5 s.
+
+Limitation: a robot that lags behind a reference running at v_max cannot catch up (its speed is
+capped at v_max too); the along-track error then persists until the reference slows down. The
+references of :func:`~anyplan.trajectory.plan_motion` start at the robot's own state, so in
+simulation the error stays at the micrometre level.
 """
 
 from __future__ import annotations

@@ -80,13 +80,15 @@ def polyline_trajectory(path: np.ndarray, spec: RobotSpec, state: RobotState, t_
                         grid_step: float = 0.02) -> Trajectory:
     """Brake if moving, then turn in place and drive straight, rest to rest, along each segment.
 
-    The path's first point is replaced by the robot's position (after braking).
+    The path continues from where the robot stops (see ``_continue_from``). The result's
+    ``certified_free`` tells whether the braking path and every segment are free for ``radius``
+    (default: the robot radius) among ``obstacles``.
     """
     r = spec.radius if radius is None else radius
     obst = obstacles if obstacles is not None else ObstacleSet()
     segs: list[Segment] = []
     t = t_start
-    brake, _ = _brake(state, spec, obst, r, t)
+    brake, free = _brake(state, spec, obst, r, t)
     x, y, th, w = state.x, state.y, state.theta, state.omega
     if brake is not None:
         segs.append(brake)
@@ -96,6 +98,7 @@ def polyline_trajectory(path: np.ndarray, spec: RobotSpec, state: RobotState, t_
         w = 0.0
     pts = clean_path(path)
     pts = _continue_from(np.array([x, y]), pts, obst, r) if len(pts) >= 2 else np.array([[x, y]])
+    free = free and obst.path_free(pts, r)
     length = 0.0
     for a, b in zip(pts[:-1], pts[1:], strict=True):
         target = math.atan2(b[1] - a[1], b[0] - a[0])
@@ -114,7 +117,7 @@ def polyline_trajectory(path: np.ndarray, spec: RobotSpec, state: RobotState, t_
     if not segs:
         segs.append(TurnSegment(x, y, rotation_profile(th, 0.0, spec.omega_max, spec.alpha_max, 0.0), t))
     return Trajectory(segs, kind="polyline", lower_bound_s=time_lower_bound(length, spec, abs(state.v)),
-                      polyline=pts)
+                      polyline=pts, certified_free=free)
 
 
 def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles: ObstacleSet,
@@ -144,6 +147,9 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
 
     Returns:
         The fastest admissible :class:`Trajectory`; ``info`` lists the candidate durations.
+        If nothing is both feasible from the current state and certified collision-free (a path
+        that itself collides, or a robot too fast for the start of every curve), the best effort
+        is returned with ``feasible`` or ``certified_free`` False.
     """
     radius = spec.radius + margin
     pts = clean_path(path)
@@ -221,8 +227,8 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         cands.append((True, tr.duration, tr))
         info["candidates"]["polyline"] = tr.duration
 
-    feasible = [c for c in cands if c[0]]
-    pool = feasible if feasible else cands
+    good = [c for c in cands if c[0] and c[2].certified_free]
+    pool = good or [c for c in cands if c[2].certified_free] or cands
     best = min(pool, key=lambda c: c[1])[2]
     best.info.update(info)
     return best

@@ -157,12 +157,15 @@ class Trajectory:
         lower_bound_s: Time lower bound [s] for driving :attr:`length` from the start speed to
             rest under v_max and a_max only (no curvature, no turning).
         polyline: The input path after cleaning (N, 2) [m].
+        certified_free: True when the whole motion was certified collision-free against the
+            obstacles given to :func:`~anyplan.trajectory.plan_motion` (False only for a polyline
+            fallback whose own segments, or braking path, are not free).
         info: Diagnostics (repair rounds, candidate times, ...).
     """
 
     def __init__(self, segments: Sequence[Segment], kind: str = "smooth", feasible: bool = True,
                  lower_bound_s: float = float("nan"), polyline: np.ndarray | None = None,
-                 info: dict | None = None) -> None:
+                 info: dict | None = None, certified_free: bool = True) -> None:
         if not segments:
             raise ValueError("a trajectory needs at least one segment")
         self.segments = list(segments)
@@ -170,6 +173,7 @@ class Trajectory:
         self.feasible = feasible
         self.lower_bound_s = lower_bound_s
         self.polyline = polyline
+        self.certified_free = certified_free
         self.info = dict(info or {})
         self._starts = np.array([s.t0 for s in self.segments])
         pts = [s.path_points(0.05) for s in self.segments]
