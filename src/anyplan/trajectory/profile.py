@@ -37,6 +37,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from anyplan.trajectory.spline import SmoothCurve
 from anyplan.world.robot import RobotSpec
@@ -111,6 +112,36 @@ def _interval_bounds(curve: SmoothCurve, u: np.ndarray) -> tuple[np.ndarray, np.
     return k * KAPPA_INFLATION + 1e-9, dk * KAPPA_INFLATION + 1e-9
 
 
+@njit(cache=True)
+def _step(x_from: float, ds: float, k: float, dk: float, a2: float, al: float) -> float:
+    """Largest |dx/ds| on an interval from its lower end value ``x_from``, moving up to
+    ``x_from + |d| ds``: K' (x_from + |d| ds) + K |d| / 2 <= alpha and |d| <= 2 a."""
+    num = al - dk * x_from
+    if num <= 0.0:
+        return 0.0
+    return min(a2, num / (dk * ds + 0.5 * k))
+
+
+@njit(cache=True)
+def _passes(ds: np.ndarray, mvc: np.ndarray, kmax: np.ndarray, dkmax: np.ndarray, a2: float,
+            al: float, x0: float) -> tuple[np.ndarray, np.ndarray]:
+    """Backward pass from rest at the end, then forward pass from ``x0``; returns (x, back)."""
+    n = len(mvc)
+    back = np.empty(n)
+    back[n - 1] = 0.0
+    for i in range(n - 2, -1, -1):
+        # Braking into node i+1 from node i: x_i = x_{i+1} + |d| ds; the interval maximum is x_i.
+        back[i] = min(mvc[i], back[i + 1] + _step(back[i + 1], ds[i], kmax[i], dkmax[i], a2, al) * ds[i])
+    x = np.empty(n)
+    x[0] = min(x0, back[0])
+    for i in range(n - 1):
+        # Accelerating from x_i. If the result is clipped by back[i+1] < x_i, braking from x_i to
+        # back[i+1] is admissible: back[i] >= x_i was built from back[i+1] with the largest
+        # admissible |d|, and the constraint is monotone in both x_i and |d|.
+        x[i + 1] = min(back[i + 1], x[i] + _step(x[i], ds[i], kmax[i], dkmax[i], a2, al) * ds[i])
+    return x, back
+
+
 def time_parameterize(curve: SmoothCurve, spec: RobotSpec, v_start: float = 0.0) -> SpeedProfile:
     """Time-optimal (on the grid) speed profile from ``v_start`` to rest at the curve's end.
 
@@ -134,29 +165,9 @@ def time_parameterize(curve: SmoothCurve, spec: RobotSpec, v_start: float = 0.0)
     mvc[-1] = xi[-1]
     mvc[1:-1] = np.minimum(xi[:-1], xi[1:])
 
-    def step(x_from: float, i: int) -> float:
-        # Largest |d| on interval i from the lower end value x_from, moving up to
-        # x_from + |d| ds: K' (x_from + |d| ds) + K |d| / 2 <= alpha and |d| <= 2 a.
-        num = al - dkmax[i] * x_from
-        if num <= 0.0:
-            return 0.0
-        return min(a2, num / (dkmax[i] * ds[i] + 0.5 * kmax[i]))
-
-    n = len(s)
-    back = np.empty(n)
-    back[-1] = 0.0
-    for i in range(n - 2, -1, -1):
-        # Braking into node i+1 from node i: x_i = x_{i+1} + |d| ds, the interval maximum is x_i.
-        back[i] = min(mvc[i], back[i + 1] + step(back[i + 1], i) * ds[i])
     v0 = max(float(v_start), 0.0)
-    x = np.empty(n)
+    x, back = _passes(ds, mvc, kmax, dkmax, a2, al, v0 * v0)
     feasible = v0 * v0 <= back[0] * (1.0 + 1e-9) + 1e-12
-    x[0] = min(v0 * v0, back[0])
-    for i in range(n - 1):
-        # Accelerating from x_i: if the result is clipped by back[i+1] < x_i the braking step is
-        # feasible because back[i] >= x_i was built from back[i+1] with the largest admissible
-        # |d|, and the constraint is monotone in both x_i and |d|.
-        x[i + 1] = min(back[i + 1], x[i] + step(x[i], i) * ds[i])
     v = np.sqrt(np.maximum(x, 0.0))
     vs = v[:-1] + v[1:]
     with np.errstate(divide="ignore"):
