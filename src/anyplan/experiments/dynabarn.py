@@ -26,7 +26,8 @@ Conventions (DynaBARN coordinates in brackets):
   the challenge's optimal time, path length / 2 m/s). The turn rate and accelerations are our
   choice, conservative for a 17 kg skid-steer robot: omega_max = 2.0 rad/s, a_max = 2.0 m/s^2,
   alpha_max = 4.0 rad/s^2. Edit the YAML files (or pass ``profile``) to change them.
-* **Moving obstacles.** ``{type: waypoints, keyframes: [[t, x, y], ...], radius: 0.5}``; the
+* **Moving obstacles.** ``{type: waypoints, keyframes: [[t, x, y], ...], radius: 0.5}``, named
+  D1..Dn in the world's order (the file's header comment maps them to DynaBARN's plugin names); the
   position at time t is the linear interpolation at ``t mod period`` with period = the last
   keyframe time, exactly DynaBARN's looping Gazebo ``PoseAnimation``. Positions are exact at the
   keyframes (the shift is one float addition per coordinate).
@@ -184,8 +185,7 @@ def world_to_scenario(world: Mapping[str, Any], profile: Mapping[str, float] | N
         if period is not None and abs(_num(period, f"{fld}.period") - rows[-1][0]) > 1e-9:
             raise DynaBARNError(f"{fld}: last keyframe time {rows[-1][0]:g} differs from the period "
                                 f"{period:g}")
-        movers.append({"name": str(m.get("name", f"D{k + 1}")), "type": "waypoints",
-                       "keyframes": rows, "radius": r})
+        movers.append({"name": f"D{k + 1}", "type": "waypoints", "keyframes": rows, "radius": r})
     sx0, sy0, th0 = START
     data = {
         "name": name or f"dynabarn-{idx:02d}",
@@ -219,9 +219,11 @@ def convert(worlds_file: str | Path, out_dir: str | Path, worlds: Sequence[int] 
             raise DynaBARNError(f"world {i} is not in {worlds_file}")
         sc = world_to_scenario(by_index[i], profile)
         p = out / f"{sc['name']}.yaml"
+        names = ", ".join(f"D{k + 1} = {m.get('name', '?')}" for k, m in enumerate(by_index[i]["moving"]))
         header = ("# Converted by 'anyplan import-dynabarn' from DynaBARN (Nair et al., SSRR 2022),\n"
                   "# BARN Challenge repository data, MIT licence, Copyright (c) 2022 Zifan Xu.\n"
-                  "# Frame: DynaBARN (x, y) + (10.5, 10.5) m. See anyplan.experiments.dynabarn.\n")
+                  "# Frame: DynaBARN (x, y) + (10.5, 10.5) m. See anyplan.experiments.dynabarn.\n"
+                  f"# Obstacles (DynaBARN plugin names): {names}\n")
         p.write_text(header + yaml.safe_dump(sc, sort_keys=False, default_flow_style=None, width=100))
         paths.append(p)
     return paths
