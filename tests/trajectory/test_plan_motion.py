@@ -147,3 +147,22 @@ def test_colliding_input_is_reported():
     tr = plan_motion(np.array([[1.0, 3.0], [9.0, 3.0]]), spec, RobotState(1.0, 3.0, 0.0), obs, 0.0,
                      max_repair_rounds=2)
     assert tr.kind == "polyline" and not tr.certified_free
+
+
+def test_certified_first_contact_with_a_moving_obstacle():
+    # How Sequential BIT* uses a Trajectory: certified first contact with a predicted disc.
+    from anyplan.geometry import first_contact
+    from anyplan.world import UnicycleMotion
+
+    sc = load_scenario("paper-1").static_only()
+    tr = plan_motion(PAPER_PATH, sc.robot, RobotState(1.5, 5.5, 0.0), sc.obstacle_set(), 0.0,
+                     shortcut=False)
+    mover = UnicycleMotion(7.0, 1.0, math.pi / 2, 0.25)
+    contact = 0.3 + 0.3
+    t_hit = first_contact(tr.positions, mover.positions, tr.max_speed + mover.max_speed, contact,
+                          tr.t_start, tr.t_end + 5.0, tol=1e-4)
+    t = np.arange(0.0, tr.t_end + 5.0, 1e-3)
+    d = np.hypot(*(tr.positions(t) - mover.positions(t)).T)
+    brute = t[np.argmax(d <= contact)] if np.any(d <= contact) else None
+    assert brute is not None and t_hit is not None
+    assert t_hit <= brute + 1e-9 and t_hit >= brute - 2e-3

@@ -110,3 +110,37 @@ def test_time_lower_bound_cases():
     assert time_lower_bound(0.4, SPEC) == pytest.approx(2.0 * np.sqrt(0.4 / 0.4))
     # cannot stop within the length: braking time
     assert time_lower_bound(0.01, SPEC, 0.4) == pytest.approx(1.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(4))
+def test_against_toppra_oracle(seed):
+    """Optional oracle (toppra is not a dependency): same v, omega and a limits, alpha off.
+
+    toppra enforces its limits at its grid points only, so it may be a little faster; ours must
+    stay within 2 % of it and must not be faster by more than toppra's own grid error.
+    """
+    ta = pytest.importorskip("toppra")
+    import dataclasses
+
+    import toppra.algorithm as algo
+    import toppra.constraint as constraint
+
+    rng = np.random.default_rng(seed)
+    pts = np.column_stack([np.linspace(0.0, 12.0, 7), rng.uniform(-2.0, 2.0, 7)])
+    c = SmoothCurve(pts)
+    spec = dataclasses.replace(SPEC, alpha_max=1e9)
+    ours = time_parameterize(c, spec).duration
+
+    def vlim(s):
+        k, _ = c.curvature(c.u_of_s(np.atleast_1d(s)))
+        v = min(spec.v_max, spec.omega_max / max(abs(float(k[0])), 1e-12))
+        return np.array([[-v, v]])
+
+    path = ta.SplineInterpolator([0.0, c.length], [[0.0], [c.length]])
+    cons = [constraint.JointVelocityConstraintVarying(vlim),
+            constraint.JointAccelerationConstraint(np.array([[-spec.a_max, spec.a_max]]))]
+    inst = algo.TOPPRA(cons, path, gridpoints=np.linspace(0.0, c.length, 2001),
+                       parametrizer="ParametrizeConstAccel")
+    ref = float(inst.compute_trajectory(0, 0).duration)
+    assert ref * 0.999 <= ours <= ref * 1.02
