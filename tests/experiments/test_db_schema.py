@@ -101,6 +101,10 @@ def test_ompl_statistics_script_appends_into_our_database(bench_db, tmp_path):
         assert [(p["time"], p["best_cost"], p["source"]) for p in prog] == [(0.1, 25.0, None),
                                                                              (0.5, 23.5, None)]
         assert len(db.query("SELECT * FROM bestPlannerConfigs")) == 2
+        # The report's cost-against-time figure draws the OMPL planner from its progress rows.
+        from anyplan.viz.report import cost_time_figure
+
+        assert cost_time_figure(db, tmp_path / "ct.png").is_file()
 
 
 def test_status_enum_keeps_ompl_values():

@@ -65,7 +65,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from anyplan.experiments.db import ResultsDB, settings_string
     from anyplan.experiments.runner import BenchInterrupted, parse_planners, run_bench
     from anyplan.experiments.suites import resolve_suite
-    from anyplan.experiments.tables import format_paper_comparison, format_text, summarize, write_tables
+    from anyplan.experiments.tables import (
+        format_paper_comparison,
+        format_text,
+        paper_runs,
+        summarize,
+        write_tables,
+    )
 
     if args.runs < 1:
         raise _usage(f"bench: --runs must be >= 1, got {args.runs}")
@@ -97,12 +103,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
     print(f"{summary.finished} runs now, {summary.skipped} already stored; "
           f"{len(runs)} runs in {db_path} for this bench ({summary.wall_time_s:.1f} s)\n")
     print(format_text(tables))
-    cmp = format_paper_comparison(tables)
+    ptables = summarize(paper_runs(runs))
+    cmp = format_paper_comparison(ptables)
     if cmp:
         print("\n" + cmp)
     if args.out:
         try:
-            paths = write_tables(tables, args.out)
+            paths = write_tables(tables, args.out, ptables)
         except OSError as exc:
             raise _usage(f"bench: --out {args.out}: cannot write ({exc.strerror})") from None
         print("\nwrote " + ", ".join(str(p) for p in paths))

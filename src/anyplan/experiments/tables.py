@@ -25,8 +25,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["PAPER_TABLES", "Stat", "TableRow", "PlannerTable", "summarize", "format_text",
-           "format_markdown", "format_csv", "format_paper_comparison", "write_tables"]
+__all__ = ["PAPER_TABLES", "PAPER_SCENARIOS", "Stat", "TableRow", "PlannerTable", "summarize",
+           "paper_runs", "format_text", "format_markdown", "format_csv", "format_paper_comparison",
+           "write_tables"]
 
 #: The paper's figures per planner registry name and number of moving obstacles:
 #: (path length [m], path generation time [s], time to goal [s]), or None for "crashed".
@@ -37,6 +38,14 @@ PAPER_TABLES: dict[str, dict[str, Any]] = {
                     "rows": {1: (12.076, 0.1841, 40.766), 2: (12.003, 0.1716, 40.218),
                              3: (12.115, 0.1835, 40.655)}},
 }
+
+#: The scenarios the paper's figures are compared with (our reconstructions of its scenes).
+PAPER_SCENARIOS = ("paper-1", "paper-2", "paper-3")
+
+
+def paper_runs(runs: Sequence[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
+    """The runs on the built-in paper scenarios: the only ones compared with the paper's tables."""
+    return [r for r in runs if r.get("scenario") in PAPER_SCENARIOS]
 
 
 @dataclass(frozen=True)
@@ -157,12 +166,14 @@ def _md(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     return "\n".join(out)
 
 
-def format_markdown(tables: Sequence[PlannerTable]) -> str:
-    """Markdown tables (one per planner) followed by the comparison with the paper."""
+def format_markdown(tables: Sequence[PlannerTable],
+                    paper_tables: Sequence[PlannerTable] | None = None) -> str:
+    """Markdown tables (one per planner), then ``paper_tables`` (tables of the runs on the paper
+    scenarios, see :func:`paper_runs`) beside the paper's figures."""
     parts = []
     for t in tables:
         parts.append(f"### {t.title}\n\n" + _md(HEADERS, [_cells(r) for r in t.rows]))
-    cmp = format_paper_comparison(tables, markdown=True)
+    cmp = format_paper_comparison(paper_tables or [], markdown=True)
     if cmp:
         parts.append("### Ours against the paper\n\n" + cmp)
     return "\n\n".join(parts) + "\n"
@@ -189,7 +200,8 @@ def format_csv(tables: Sequence[PlannerTable]) -> str:
 
 
 def format_paper_comparison(tables: Sequence[PlannerTable], markdown: bool = False) -> str:
-    """The paper's Tables 2-3 beside ours, for the planners the paper reports (empty if none)."""
+    """The paper's Tables 2-3 beside ``tables``, for the planners the paper reports (empty if
+    none). Pass tables of the runs on the paper scenarios only (:func:`paper_runs`)."""
     headers = ["moving obstacles", "path length [m] ours", "paper", "generation time [s] ours",
                "paper", "time to goal [s] ours", "paper", "successes ours"]
     parts = []
@@ -217,11 +229,12 @@ def format_paper_comparison(tables: Sequence[PlannerTable], markdown: bool = Fal
     return "\n\n".join(parts)
 
 
-def write_tables(tables: Sequence[PlannerTable], out: str | Path) -> list[Path]:
+def write_tables(tables: Sequence[PlannerTable], out: str | Path,
+                 paper_tables: Sequence[PlannerTable] | None = None) -> list[Path]:
     """Write ``tables.md`` and ``tables.csv`` into folder ``out``; returns the paths."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     md, cs = out / "tables.md", out / "tables.csv"
-    md.write_text("# Benchmark tables\n\n" + format_markdown(tables))
+    md.write_text("# Benchmark tables\n\n" + format_markdown(tables, paper_tables))
     cs.write_text(format_csv(tables))
     return [md, cs]

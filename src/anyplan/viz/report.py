@@ -36,6 +36,7 @@ from anyplan.experiments.tables import (  # noqa: E402
     PAPER_TABLES,
     PlannerTable,
     _cells,
+    paper_runs,
     summarize,
     write_tables,
 )
@@ -288,7 +289,8 @@ def build_report(db_path: str | Path, out: str | Path) -> list[Path]:
     with ResultsDB(db_path) as db:
         runs = db.runs()
         tables = summarize(runs)
-        written = write_tables(tables, out)
+        ptables = summarize(paper_runs(runs))
+        written = write_tables(tables, out, ptables)
         figs = [("Figure 4: executed paths", figure4(db, out / "figure4.png")),
                 ("Metrics", boxplots(db, out / "boxplots.png")),
                 ("Cost against time", cost_time_figure(db, out / "cost_time.png"))]
@@ -310,7 +312,7 @@ def build_report(db_path: str | Path, out: str | Path) -> list[Path]:
              "<h2>Tables</h2>"]
     for t in tables:
         parts.append(f"<h3>{html.escape(t.title)}</h3>" + _html_table(HEADERS, [_cells(r) for r in t.rows]))
-    parts.append(_paper_html(tables))
+    parts.append(_paper_html(ptables))
     parts.append("<h2>Scenarios</h2>" + _html_table(
         ["experiment", "scenario", "moving obstacles", "hash", "master seed", "runs", "version"],
         [[str(e["id"]), str(e["name"]), str(e.get("moving_obstacles", "")), str(e.get("scenario_hash", "")),
