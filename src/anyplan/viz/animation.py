@@ -38,7 +38,7 @@ from anyplan.world.scenario import Scenario  # noqa: E402
 __all__ = ["animate_run", "check_target", "frame_times", "ffmpeg_available", "state_at"]
 
 ROBOT_COLOR = "#1f77b4"
-PLAN_COLOR = "#ff7f0e"
+PLAN_COLOR = "#222222"
 VIRTUAL_FACE = "#1e63d6"
 MOVER_COLORS = ["#d62728", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22"]
 
