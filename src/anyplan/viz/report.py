@@ -52,6 +52,11 @@ def draw_run_panel(ax: Any, scenario: Scenario, result: dict[str, Any]) -> None:
     from anyplan.viz.run import draw_run
 
     draw_run(ax, scenario, result, colorbar=False, title=False)
+    # Obstacles may leave the arena: keep the panel on the arena and clip labels outside it.
+    ax.set_xlim(-0.3, scenario.width + 0.3)
+    ax.set_ylim(-0.3, scenario.height + 0.3)
+    for artist in [*ax.texts, *ax.patches, *ax.lines, *ax.collections]:
+        artist.set_clip_on(True)
 
 
 def _scenarios(db: ResultsDB) -> dict[int, Scenario]:
@@ -121,7 +126,7 @@ def figure4(db: ResultsDB, path: str | Path, max_columns: int = 3) -> Path | Non
                 ax.set_xlabel("")
     fig.suptitle("Executed paths per planner (rows) and scenario (columns), as the paper's Figure 4",
                  fontsize=11)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
     path = Path(path)
     fig.savefig(path, dpi=110)
     plt.close(fig)
