@@ -123,7 +123,10 @@ def animate_run(scenario: Scenario, result: Any, path: str | Path, *, speed: flo
     Raises:
         ValueError: an unknown suffix, MP4 without ffmpeg, or a non-positive speed/fps.
     """
-    from anyplan.viz.run import draw_scenario
+    try:
+        from anyplan.viz.run import draw_scenario
+    except ImportError:
+        from anyplan.viz._fallback import draw_scenario
 
     check_target(path, speed)
     path = Path(path)

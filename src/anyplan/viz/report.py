@@ -48,8 +48,12 @@ PLANNER_COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564
 
 
 def draw_run_panel(ax: Any, scenario: Scenario, result: dict[str, Any]) -> None:
-    """One run on ``ax``: the lead's :func:`anyplan.viz.run.draw_run` without colour bar/title."""
-    from anyplan.viz.run import draw_run
+    """One run on ``ax``: :func:`anyplan.viz.run.draw_run` without colour bar and title (a minimal
+    drawing if that module is unavailable)."""
+    try:
+        from anyplan.viz.run import draw_run
+    except ImportError:
+        from anyplan.viz._fallback import draw_run
 
     draw_run(ax, scenario, result, colorbar=False, title=False)
     # Obstacles may leave the arena: keep the panel on the arena and clip labels outside it.
