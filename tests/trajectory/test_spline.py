@@ -138,3 +138,11 @@ def test_shortcut_removes_jitter_and_keeps_clearance():
     assert length(out) < length(path)
     # every kept point is a vertex of the input
     assert all(np.any(np.all(path == q, axis=1)) for q in out)
+
+
+@pytest.mark.parametrize("mode", ["project", "midpoint"])
+def test_both_repair_modes_certify(mode, world_factory):
+    obs, path, spec = world_factory(5)
+    res = smooth_path(path, obs, spec.radius, repair=mode)
+    assert res.curve is not None
+    assert dense_min_clearance(res.curve, obs, 100_000) >= spec.radius - 1e-9

@@ -20,12 +20,19 @@ along the piece if the chord's *exact* clearance (:meth:`ObstacleSet.segments_cl
 least R + M_j h_j^2 / 8. Pieces that fail are subdivided a few times before they are declared
 in collision, so the test is sufficient (never misses a contact) and nearly tight.
 
-Repair (:func:`smooth_path`): where a spline interval (between two consecutive interpolation
-points) is not certified, the midpoints of that polyline segment and of its neighbours are added
-to the interpolation points. The new points lie on the polyline, so the geometric route is
-unchanged while the spline is pulled toward the segments; as the points get denser the spline
-converges to the polyline, which is free, so a few rounds suffice in practice. If they do not,
-the caller falls back to the polyline (see :mod:`anyplan.trajectory.motion`).
+Repair (:func:`smooth_path`): in every interpolation interval where the curve is not certified,
+the worst point is projected onto the interval's polyline segment and that projection (kept to
+the middle 60 % of the segment) becomes a new interpolation point. New points lie on the
+polyline, so the geometric route is unchanged while the spline is pulled back toward the
+segments exactly where it strayed; as points accumulate the spline converges to the polyline,
+which is free, so a few rounds suffice whenever the polyline has some slack. (The alternative
+``repair="midpoint"`` splits the offending segment and its neighbours in half; it tightens more
+corners than needed: on 24 random worlds with 20 obstacles its worst duration / lower bound was
+1.088 against 1.054.) If repair fails, the caller falls back to the polyline
+(see :mod:`anyplan.trajectory.motion`).
+
+Path shortcutting (:func:`shortcut_path`) runs first: sampling planners return many jittery
+vertices, and a spline through all of them wiggles.
 """
 
 from __future__ import annotations
@@ -291,26 +298,14 @@ class SmoothCurve:
         return self.position(self.u_of_s(np.linspace(0.0, self.length, n)))
 
 
-def curve_clearance_ok(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
-                       max_depth: int = 4) -> tuple[bool, np.ndarray, float]:
-    """Certified check that a disc of ``radius`` [m] swept along ``curve`` touches nothing.
-
-    Args:
-        curve: The curve.
-        obstacles: Static obstacles and walls.
-        radius: Required clearance [m] of the curve (robot radius plus any margin).
-        max_depth: Each failing grid piece is split in 4, at most this many times, before it
-            is reported as colliding.
-
-    Returns:
-        ``(free, bad, margin)``: whether the whole curve is certified free; the sorted indices k
-        of the interpolation intervals (``curve.point_u[k:k+2]``) that could not be certified; and a certified
-        lower bound [m] of the clearance minus ``radius`` over the certified pieces.
-    """
+def _certify(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
+             max_depth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """Failing pieces: (interval index k, piece midpoint u, certified clearance), and the margin."""
     u = curve.u_grid
     limit = radius - COLLISION_EPS
     a_u, b_u = u[:-1], u[1:]
-    bad_idx: list[int] = []
+    fail_u = np.zeros(0)
+    fail_c = np.zeros(0)
     margin = math.inf
     for depth in range(max_depth + 1):
         if len(a_u) == 0:
@@ -327,16 +322,37 @@ def curve_clearance_ok(curve: SmoothCurve, obstacles: ObstacleSet, radius: float
             margin = min(margin, float(np.min(clr[ok])) - radius)
         fail = ~ok
         if not np.any(fail):
-            a_u = b_u = np.zeros(0)
             break
         if depth == max_depth:
-            bad_idx.extend(curve.point_index(0.5 * (a_u[fail] + b_u[fail])).tolist())
+            fail_u = 0.5 * (a_u[fail] + b_u[fail])
+            fail_c = clr[fail]
             break
         fa, fb = a_u[fail], b_u[fail]
         parts = np.linspace(0.0, 1.0, 5)
         sub = fa[:, None] + (fb - fa)[:, None] * parts[None, :]
         a_u, b_u = sub[:, :-1].ravel(), sub[:, 1:].ravel()
-    bad = np.unique(np.array(bad_idx, dtype=int))
+    return curve.point_index(fail_u), fail_u, fail_c, margin
+
+
+def curve_clearance_ok(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
+                       max_depth: int = 4) -> tuple[bool, np.ndarray, float]:
+    """Certified check that a disc of ``radius`` [m] swept along ``curve`` touches nothing.
+
+    Args:
+        curve: The curve.
+        obstacles: Static obstacles and walls.
+        radius: Required clearance [m] of the curve (robot radius plus any margin).
+        max_depth: Each failing grid piece is split in 4, at most this many times, before it
+            is reported as colliding.
+
+    Returns:
+        ``(free, bad, margin)``: whether the whole curve is certified free; the sorted indices k
+        of the interpolation intervals (``curve.point_u[k:k+2]``) that could not be certified;
+        and a certified lower bound [m] of the clearance minus ``radius`` over the certified
+        pieces.
+    """
+    k, _, _, margin = _certify(curve, obstacles, radius, max_depth)
+    bad = np.unique(k.astype(int))
     return len(bad) == 0, bad, margin
 
 
@@ -360,7 +376,8 @@ class SmoothingResult:
 
 def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
                 start_heading: float | None = None, max_rounds: int = 10,
-                grid_step: float = 0.02, min_segment: float = 0.02) -> SmoothingResult:
+                grid_step: float = 0.02, min_segment: float = 0.02,
+                repair: str = "project") -> SmoothingResult:
     """Fit a cubic spline through ``path`` and repair it until it is certified collision-free.
 
     Args:
@@ -371,6 +388,9 @@ def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
         max_rounds: Repair rounds before giving up.
         grid_step: Evaluation grid spacing [m] (see :class:`SmoothCurve`).
         min_segment: Polyline segments shorter than this [m] are not split further.
+        repair: ``"project"`` (default): in each interval that is not certified, insert the
+            projection of its worst point onto the polyline segment (clamped to the middle 60 %
+            of the segment); ``"midpoint"``: split that segment and both neighbours in half.
 
     Returns:
         A :class:`SmoothingResult`; ``curve`` is None when no certified curve was found.
@@ -384,23 +404,32 @@ def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
         if not curve.is_regular():
             # a cusp comes from the start heading, which no repair changes
             return SmoothingResult(None, rnd, len(pts) - n0, float("nan"))
-        free, bad, margin = curve_clearance_ok(curve, obstacles, radius)
-        if free:
+        kk, fu, fc, margin = _certify(curve, obstacles, radius, 4)
+        if len(kk) == 0:
             return SmoothingResult(curve, rnd, len(pts) - n0, margin)
         if rnd == max_rounds:
             break
-        # Split the offending polyline segments and their neighbours at their midpoints.
-        split = set()
-        for k in bad.tolist():
-            for j in (k - 1, k, k + 1):
-                if 0 <= j < len(pts) - 1:
-                    split.add(j)
+        if repair == "midpoint":
+            # Split the offending polyline segments and their neighbours at their midpoints.
+            split = {j: 0.5 for k in np.unique(kk).tolist() for j in (k - 1, k, k + 1)
+                     if 0 <= j < len(pts) - 1}
+        else:
+            # Project the worst point of each offending interval onto its polyline segment and
+            # insert it there (kept away from the ends so that segments shrink geometrically).
+            split = {}
+            for k in np.unique(kk).tolist():
+                sel = kk == k
+                q = curve.position(fu[sel][np.argmin(fc[sel])][None])[0]
+                a, b = pts[k], pts[k + 1]
+                ab = b - a
+                lam = float((q - a) @ ab) / float(ab @ ab)
+                split[k] = min(max(lam, 0.2), 0.8)
         new = [pts[0]]
         added = 0
         for j in range(len(pts) - 1):
             a, b = pts[j], pts[j + 1]
             if j in split and math.hypot(*(b - a)) > min_segment:
-                new.append(0.5 * (a + b))
+                new.append(a + split[j] * (b - a))
                 added += 1
             new.append(b)
         if added == 0:
