@@ -117,8 +117,9 @@ def draw_velocity_space(ax: Any, decision: Decision, *, resolution: int = 241) -
     ax.grid(True, lw=0.4, alpha=0.5, zorder=0)
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
               frameon=False, borderaxespad=0.0)
-    ax.set_title(f"DOVS velocity space: chosen (v, $\\omega$) = ({s.v:.3f} m/s, {s.omega:+.3f} rad/s)",
-                 fontsize=10)
+    ax.set_title(f"DOVS velocity space: chosen (v, $\\omega$) = ({s.v:.3f} m/s, {s.omega:+.3f} rad/s)\n"
+                 f"period T = {cfg.control_period_s:g} s, horizon $T_h$ = {cfg.time_horizon_s:g} s, "
+                 f"merge = {cfg.merge}, {s.n_free} of {s.n_candidates} window samples free", fontsize=10)
 
 
 def draw_decision_world(ax: Any, scenario: Scenario, decision: Decision,
