@@ -97,3 +97,29 @@ def test_robot_limits_come_from_the_scenario() -> None:
     free = DOVSAgent(v_max=0.3, use_robot_limits=False)
     free.reset(sc.static_only(), np.random.default_rng(0))
     assert free.config.v_max == 0.3
+
+
+def test_wall_across_the_route_stops_the_robot_before_it() -> None:
+    """The braking rule: driving at a wall, the robot stops short of it (DOVS is then stuck:
+    a documented failure mode, reported as a timeout, never as a crash)."""
+    from anyplan.world.scenario import scenario_from_dict
+
+    sc = scenario_from_dict({
+        "name": "wall", "time_limit": 25.0, "arena": {"width": 8.0, "height": 4.0},
+        "robot": {"start": [1.0, 2.0, 0.0], "goal": [7.0, 2.0], "radius": 0.3, "v_max": 0.4,
+                  "omega_max": 0.4, "a_max": 0.4, "alpha_max": 1.0},
+        "static_obstacles": [{"name": "W", "type": "rectangle", "center": [4.0, 2.0],
+                              "size": [0.4, 4.0], "angle": 0.0}],
+        "dynamic_obstacles": [],
+    })
+    agent = make_agent("dovs")
+    res = simulate(sc, agent, seed=0)
+    assert res.status == "timeout" and not res.collision
+    traj = res.trajectory_array
+    cfg = agent.config
+    # Straight at the wall: contact at x = 3.8 - 1.1 * 0.3; the rule keeps d_safe of it, up to the
+    # distance driven in the period before the next check.
+    contact_x = 3.8 - cfg.static_clearance
+    assert traj[:, 1].max() <= contact_x - cfg.d_safe + cfg.v_max * cfg.control_period_s
+    assert traj[:, 1].max() > 2.5  # it did drive up to the wall
+    assert res.min_clearance_m > 0.0
