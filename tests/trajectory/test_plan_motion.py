@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from anyplan.geometry import Circle, ObstacleSet, rectangle
-from anyplan.trajectory import Trajectory, plan_motion, polyline_trajectory
+from anyplan.trajectory import SmoothCurve, Trajectory, plan_motion, polyline_trajectory
 from anyplan.world import RobotState, load_scenario
 
 PAPER_PATH = np.array([[1.5, 5.5], [5.5, 5.5], [6.0, 5.0], [8.0, 5.2], [13.5, 5.5]])
@@ -166,3 +166,31 @@ def test_certified_first_contact_with_a_moving_obstacle():
     brute = t[np.argmax(d <= contact)] if np.any(d <= contact) else None
     assert brute is not None and t_hit is not None
     assert t_hit <= brute + 1e-9 and t_hit >= brute - 2e-3
+
+
+@pytest.mark.parametrize(("w0", "target"), [(0.4, 0.0), (-0.4, 0.5), (0.2, -0.8), (0.0, 0.5)])
+def test_smooth_start_matches_the_current_turn_rate(w0, target, limits_checker):
+    # Replanning while driving on a curve: the reference starts at the robot's own (v, omega).
+    spec = load_scenario("paper-1").robot
+    obs = ObstacleSet([], bounds=(0.0, 0.0, 20.0, 20.0))
+    st = RobotState(5.0, 10.0, 0.0, 0.4, w0)
+    path = np.array([[5.0, 10.0], [5.0 + 8.0 * math.cos(target), 10.0 + 8.0 * math.sin(target)]])
+    tr = plan_motion(path, spec, st, obs, 0.0)
+    assert tr.kind == "smooth"
+    _, _, th, v, w = tr.sample(np.array([0.0]))
+    assert th[0] == pytest.approx(0.0, abs=1e-12)
+    assert 0.4 - 0.01 <= v[0] <= 0.4 + 1e-12
+    assert w[0] == pytest.approx(w0 * v[0] / 0.4, abs=1e-9)
+    limits_checker(tr, spec)
+    # it beats stopping and turning toward the path
+    assert tr.duration < tr.info["candidates"]["turn+smooth"]
+
+
+def test_curvature_matched_curve_keeps_points_and_conditions():
+    pts = np.array([[0.0, 0.0], [1.0, 0.2], [2.4, 0.8], [3.9, 0.6], [6.0, 0.0]])
+    for k0 in (-1.0, 0.0, 0.5, 2.0):
+        c = SmoothCurve(pts, start_heading=0.3, start_curvature=k0)
+        np.testing.assert_allclose(c.position(c.point_u), pts, atol=1e-12)
+        k, _ = c.curvature(np.array([0.0, c.knots[-1]]))
+        assert k[0] == pytest.approx(k0, abs=1e-9) and abs(k[1]) < 1e-9
+        assert c.heading(np.array([0.0]))[0] == pytest.approx(0.3, abs=1e-12)

@@ -4,7 +4,8 @@ The chain of the paper (§4): smooth the path with a cubic spline, repair it whe
 obstacle, generate the reference motion within the robot's limits, and, when the robot must take
 up a path whose direction differs from its heading, turn in place first. Candidates:
 
-* ``smooth``: drive off along a spline that starts with the robot's heading and speed;
+* ``smooth``: drive off along a spline that starts with the robot's heading, speed and
+  curvature omega0 / v0 (so the reference turn rate starts at the robot's own);
 * ``turn+smooth`` (only if the heading differs): brake to rest if moving, turn in place toward
   the path (:mod:`anyplan.trajectory.turn`), then drive a spline tangent to the first segment;
 * ``polyline`` (fallback when no spline can be certified collision-free): brake if moving, then
@@ -39,6 +40,8 @@ __all__ = ["plan_motion", "turn_segment", "polyline_trajectory"]
 
 _EPS_V = 1e-6  # [m/s] speeds below this count as rest
 _EPS_TH = 1e-3  # [rad] headings closer than this count as aligned
+_V_CURVATURE = 0.02  # [m/s] above this speed the start curvature omega0 / v0 is matched
+_MAX_START_CURVATURE = 5.0  # [1/m] tighter start curvatures are not matched
 
 
 def turn_segment(x: float, y: float, theta: float, target: float, spec: RobotSpec, t0: float,
@@ -123,7 +126,7 @@ def polyline_trajectory(path: np.ndarray, spec: RobotSpec, state: RobotState, t_
 def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles: ObstacleSet,
                 t_start: float, *, margin: float = 0.0, grid_step: float = 0.02,
                 max_repair_rounds: int = 10, allow_turn: bool = True, shortcut: bool = True,
-                shortcut_slack: float = 0.01) -> Trajectory:
+                shortcut_slack: float = 0.01, start_speed_tolerance: float = 0.01) -> Trajectory:
     """Turn a planned polyline into a timed, collision-free reference motion.
 
     Args:
@@ -144,6 +147,10 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
             obstacle the path avoids (virtual ones included).
         shortcut_slack: Extra clearance [m] of shortcut segments, left for the spline to round
             the corners in.
+        start_speed_tolerance: The smooth start is accepted when its reference starts at most
+            this much [m/s] below the robot's speed (the curvature bounds are inflated by 2 %, so
+            a robot turning at exactly omega_max would otherwise never qualify); keep it below
+            a_max times the control period so the robot matches the reference within one step.
 
     Returns:
         The fastest admissible :class:`Trajectory`; ``info`` lists the candidate durations.
@@ -177,22 +184,30 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
     info: dict = {"candidates": {}, "input_vertices": n_input, "vertices": len(pts)}
 
     # A. smooth start along the current heading, at the current speed.
+    # A robot already turning (omega0 = kappa0 v0) takes up a curve with the same curvature, so
+    # that the reference turn rate does not jump at the start.
+    k0 = state.omega / v0 if v0 > _V_CURVATURE else math.inf
     res = smooth_path(pts, obstacles, radius, start_heading=state.theta, max_rounds=max_repair_rounds,
-                      grid_step=grid_step)
+                      grid_step=grid_step,
+                      start_curvature=k0 if abs(k0) <= _MAX_START_CURVATURE else None)
     if res.curve is not None:
         prof = time_parameterize(res.curve, spec, v0)
+        # A start speed a little above what the (conservatively bounded) curve admits is
+        # absorbed within one control step: accept it up to start_speed_tolerance.
+        ok_a = prof.feasible or v0 - float(prof.v[0]) <= start_speed_tolerance
         seg_a = CurveSegment(res.curve, prof, t_start)
-        tr = Trajectory([seg_a], kind="smooth", feasible=prof.feasible,
+        tr = Trajectory([seg_a], kind="smooth", feasible=ok_a,
                         lower_bound_s=time_lower_bound(res.curve.length, spec, v0), polyline=pts,
                         info={"repair_rounds": res.rounds, "points_added": res.points_added,
                               "certified_margin_m": res.margin})
-        cands.append((prof.feasible, tr.duration, tr))
-        info["candidates"]["smooth"] = tr.duration if prof.feasible else math.inf
+        cands.append((ok_a, tr.duration, tr))
+        info["candidates"]["smooth"] = tr.duration if ok_a else math.inf
 
     # B. brake (if moving), turn in place toward the path, then a spline tangent to it.
     first_dir = math.atan2(pts[1][1] - pts[0][1], pts[1][0] - pts[0][0])
     misaligned = abs(float(wrap_angle(first_dir - state.theta))) > _EPS_TH
-    if allow_turn and (misaligned or res.curve is None or not cands[-1][0]):
+    turning = abs(state.omega) > 1e-3
+    if allow_turn and (misaligned or turning or res.curve is None or not cands[-1][0]):
         segs: list[Segment] = []
         t = t_start
         brake, brake_free = _brake(state, spec, obstacles, radius, t)

@@ -41,7 +41,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import CubicSpline
+from scipy.interpolate import CubicSpline, make_interp_spline
 
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 
@@ -58,6 +58,9 @@ __all__ = [
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(5)
 _GL_X = 0.5 * (_GL_X + 1.0)
 _GL_W = 0.5 * _GL_W
+
+#: Distance [m] of the extra knot from the start when a start curvature is imposed.
+START_KNOT = 0.5
 
 #: Largest tangent turn [rad] across one evaluation-grid interval.
 MAX_TURN = 0.05
@@ -149,6 +152,11 @@ class SmoothCurve:
         points: Interpolation points (N >= 2, 2) [m], consecutive points distinct.
         start_heading: If given, the curve leaves ``points[0]`` along this heading [rad]
             (clamped unit tangent); otherwise the start is natural (zero curvature).
+        start_curvature: With ``start_heading``, also the signed curvature [1/m] at the start,
+            so that a robot already turning at omega = kappa v can take up the curve without a
+            jump in its turn rate. This needs one more degree of freedom than a cubic spline
+            through the points has: a C2 cubic B-spline (``scipy.interpolate.make_interp_spline``)
+            with one extra knot in the first interval is used instead.
         grid_step: Target spacing [m] of the evaluation grid used for arc length tables,
             speed profiles and collision certification (finer where the tangent turns by more
             than ``MAX_TURN`` across a step).
@@ -166,7 +174,7 @@ class SmoothCurve:
 
     def __init__(self, points: np.ndarray, start_heading: float | None = None,
                  grid_step: float = 0.02, reparam_iters: int = 2,
-                 resample_step: float = 0.05) -> None:
+                 resample_step: float = 0.05, start_curvature: float | None = None) -> None:
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
         if len(pts) < 2:
             raise ValueError("a curve needs at least two points")
@@ -175,16 +183,29 @@ class SmoothCurve:
             raise ValueError("consecutive curve points must be distinct")
         self.points = pts
         self.start_heading = start_heading
+        self.start_curvature = start_curvature if start_heading is not None else None
         if start_heading is None:
             bc: object = "natural"
         else:
             tan = np.array([math.cos(start_heading), math.sin(start_heading)])
             bc = ((1, tan), (2, np.zeros(2)))
+            if self.start_curvature is not None:
+                nrm = np.array([-tan[1], tan[0]]) * float(self.start_curvature)
+                bc = ([(1, tan), (2, nrm)], [(2, np.zeros(2))])
+
+        def fit(x: np.ndarray, y: np.ndarray):
+            if self.start_curvature is None:
+                return CubicSpline(x, y, axis=0, bc_type=bc)
+            # The extra knot sets how far the start curvature reaches into the curve.
+            extra = x[0] + min(0.5 * (x[1] - x[0]), START_KNOT)
+            t = np.concatenate([[x[0]] * 4, [extra], x[1:-1], [x[-1]] * 4])
+            return make_interp_spline(x, y, k=3, t=t, bc_type=bc, axis=0)
+
         u = np.concatenate([[0.0], np.cumsum(chords)])
         for _ in range(max(reparam_iters, 0)):
-            cs = CubicSpline(u, pts, axis=0, bc_type=bc)
+            cs = fit(u, pts)
             u = np.concatenate([[0.0], np.cumsum(self._piece_lengths(cs, u))])
-        cs = CubicSpline(u, pts, axis=0, bc_type=bc)
+        cs = fit(u, pts)
         # Arc-length parameterisation: resample every piece at equal parameter steps, take the
         # exact arc length of each sample as its parameter and interpolate again. The samples
         # include the interpolation points, so those (and the end conditions) are kept; the
@@ -192,8 +213,9 @@ class SmoothCurve:
         us = _subdivide(u, np.maximum(4, np.ceil(np.diff(u) / resample_step)).astype(np.int64))
         s_of_us = np.concatenate([[0.0], np.cumsum(self._piece_lengths(cs, us))])
         self.point_u = s_of_us[np.searchsorted(us, u)]
-        self.knots = s_of_us
-        self._cs = CubicSpline(s_of_us, cs(us), axis=0, bc_type=bc)
+        self._cs = fit(s_of_us, cs(us))
+        # Breakpoints of the final piecewise cubic (with the extra knot of the B-spline variant).
+        self.knots = np.unique(self._cs.t) if self.start_curvature is not None else s_of_us
         u = self.knots
         self._d1 = self._cs.derivative(1)
         self._d2 = self._cs.derivative(2)
@@ -214,7 +236,7 @@ class SmoothCurve:
 
     # --- evaluation -------------------------------------------------------------------------
     @staticmethod
-    def _piece_lengths(cs: CubicSpline, u: np.ndarray) -> np.ndarray:
+    def _piece_lengths(cs, u: np.ndarray) -> np.ndarray:
         # 4 sub-intervals x 5 Gauss points per piece: relative error far below 1e-9 here.
         h = np.diff(u)[:, None] / 4.0
         nodes = (u[:-1, None] + h * (np.arange(4)[:, None] + _GL_X[None, :]).ravel()[None, :])
@@ -377,7 +399,7 @@ class SmoothingResult:
 def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
                 start_heading: float | None = None, max_rounds: int = 10,
                 grid_step: float = 0.02, min_segment: float = 0.02,
-                repair: str = "project") -> SmoothingResult:
+                repair: str = "project", start_curvature: float | None = None) -> SmoothingResult:
     """Fit a cubic spline through ``path`` and repair it until it is certified collision-free.
 
     Args:
@@ -388,6 +410,8 @@ def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
         max_rounds: Repair rounds before giving up.
         grid_step: Evaluation grid spacing [m] (see :class:`SmoothCurve`).
         min_segment: Polyline segments shorter than this [m] are not split further.
+        start_curvature: Curvature [1/m] at the start (with ``start_heading``), see
+            :class:`SmoothCurve`.
         repair: ``"project"`` (default): in each interval that is not certified, insert the
             projection of its worst point onto the polyline segment (clamped to the middle 60 %
             of the segment); ``"midpoint"``: split that segment and both neighbours in half.
@@ -400,7 +424,8 @@ def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
         raise ValueError("path must contain two distinct points")
     n0 = len(pts)
     for rnd in range(max_rounds + 1):
-        curve = SmoothCurve(pts, start_heading=start_heading, grid_step=grid_step)
+        curve = SmoothCurve(pts, start_heading=start_heading, grid_step=grid_step,
+                            start_curvature=start_curvature)
         if not curve.is_regular():
             # a cusp comes from the start heading, which no repair changes
             return SmoothingResult(None, rnd, len(pts) - n0, float("nan"))
