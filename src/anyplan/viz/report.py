@@ -251,6 +251,10 @@ def cost_time_figure(db: ResultsDB, path: str | Path) -> Path | None:
             else:
                 ax.plot([], [], color=color, lw=2, label=f"{planner} ({len(curves)} runs)")
         ax.set_title(scn, fontsize=10)
+        if not anytime:  # a single plan at t = 0 would give a degenerate axis
+            t_hi = max((t for (s_, _), runs in by.items() if s_ == scn for v in runs.values() for t, _ in v),
+                       default=0.0)
+            ax.set_xlim(-0.02 * max(t_hi, 1.0), 1.05 * max(t_hi, 1.0))
         ax.set_xlabel("planning time [s]" if anytime else "simulated time [s]")
         ax.set_ylabel("best cost [m]" if anytime else "plan length [m]")
         ax.grid(alpha=0.3)
