@@ -92,6 +92,9 @@ def test_bench_resume_flag_and_refusal(tmp_path, tiny, capsys):
     (["--jobs", "0"], "--jobs must be >= 1"),
     (["--suite", "nope.yaml"], "nope.yaml: no such file"),
     (["--resume", "--db", "missing.db"], "does not exist"),
+    (["--planners", "straight", "--config", 'straight={"nope": 1}'], "unexpected keyword argument 'nope'"),
+    (["--planners", "straight", "--config", "straight=[1"], "--config straight: not JSON"),
+    (["--planners", "straight", "--config", "dovs={}"], "'dovs' is not in --planners"),
 ])
 def test_bench_bad_input_is_one_line(tmp_path, tiny, capsys, argv, message, monkeypatch):
     monkeypatch.chdir(tmp_path)
@@ -114,3 +117,22 @@ def test_paper_figures_are_printed_beside_ours():
     assert "12.076" in text and "0.1841" in text and "40.766" in text   # Table 3
     assert "18.762" in text and "0.25188" in text and "crashed" in text  # Table 2
     assert "12.500 ± 0.400" in text
+
+
+def test_planner_config_is_used_and_recorded(tmp_path):
+    turned = yaml.safe_load(yaml.safe_dump(agents.TINY))
+    turned["robot"]["start"][2] = 1.5  # facing away from the goal: align_tolerance matters
+    tiny = tmp_path / "turned.yaml"
+    tiny.write_text(yaml.safe_dump(turned))
+    db = tmp_path / "c.db"
+    args = ["bench", "--suite", str(tiny), "--planners", "straight", "--runs", "1", "--jobs", "1",
+            "--db", str(db), "--no-progress"]
+    assert main([*args, "--config", 'straight={"align_tolerance": 3.2}']) == 0
+    assert main(args) == 0  # the default config is another planner configuration: no overlap
+    conn = sqlite3.connect(db)
+    rows = conn.execute("SELECT p.settings, r.time_to_goal FROM runs r JOIN plannerConfigs p "
+                        "ON p.id = r.plannerid ORDER BY p.id").fetchall()
+    conn.close()
+    assert [r[0] for r in rows] == ["align_tolerance = 3.2;", ""]
+    # Driving off without first turning to the goal takes a different time.
+    assert rows[0][1] != rows[1][1]

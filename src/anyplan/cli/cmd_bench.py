@@ -24,6 +24,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "files, or a comma-separated list of files/built-in names (default paper)")
     p.add_argument("--planners", default="straight",
                    help="comma-separated planner names (default straight)")
+    p.add_argument("--config", action="append", default=[], metavar="NAME=JSON",
+                   help="keyword config of one planner as a JSON object, e.g. "
+                        "'bitstar={\"time_budget_s\": 0.2}' (repeatable; recorded in plannerConfigs)")
     p.add_argument("--runs", type=int, default=30, help="runs per (scenario, planner) (default 30)")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
                    help="worker processes (default: the number of CPUs; 1 = no subprocess)")
@@ -77,7 +80,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         raise _usage(f"bench: --runs must be >= 1, got {args.runs}")
     if args.jobs < 1:
         raise _usage(f"bench: --jobs must be >= 1, got {args.jobs}")
-    planners = parse_planners(args.planners)
+    planners = parse_planners(args.planners, args.config)
     scenarios = resolve_suite(args.suite, random_seed=args.seed if args.random_seed is None
                               else args.random_seed, per_count=args.random_count)
     db_path = Path(args.db)

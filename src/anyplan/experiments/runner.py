@@ -67,18 +67,49 @@ class PlannerSpec:
         return settings_string(self.config)
 
 
-def parse_planners(text: str) -> list[PlannerSpec]:
-    """Planners from a comma-separated list of registry names (``"seq-bitstar,dovs"``).
+def parse_planners(text: str, configs: Sequence[str] = ()) -> list[PlannerSpec]:
+    """Planners from a comma-separated list of registry names (``"seq-bitstar,dovs"``), each
+    with the keyword config given by a ``NAME=JSON-object`` item of ``configs`` (e.g.
+    ``'bitstar={"time_budget_s": 0.2}'``), if any.
 
     Raises:
-        BenchError: an empty list or a repeated name.
+        BenchError: an empty list, a repeated name, or a malformed/unused config.
     """
     names = [s.strip() for s in text.split(",") if s.strip()]
     if not names:
         raise BenchError("--planners: expected a comma-separated list of planner names")
     if len(set(names)) != len(names):
         raise BenchError(f"--planners: a planner is listed twice ({text})")
-    return [PlannerSpec(n) for n in names]
+    cfg: dict[str, dict[str, Any]] = {}
+    for item in configs:
+        name, sep, blob = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise BenchError(f"--config: expected NAME=JSON, got '{item}'")
+        if name not in names:
+            raise BenchError(f"--config: planner '{name}' is not in --planners ({', '.join(names)})")
+        try:
+            obj = json.loads(blob)
+        except json.JSONDecodeError as exc:
+            raise BenchError(f"--config {name}: not JSON ({exc.msg} at column {exc.colno})") from None
+        if not isinstance(obj, dict):
+            raise BenchError(f"--config {name}: expected a JSON object like {{\"key\": 1}}")
+        cfg.setdefault(name, {}).update(obj)
+    return [PlannerSpec(n, cfg.get(n, {})) for n in names]
+
+
+def check_planner_config(spec: PlannerSpec) -> None:
+    """Instantiate the planner once with its config, so a bad keyword fails before the bench.
+
+    Raises:
+        BenchError: the agent rejects its config.
+    """
+    if not spec.config:
+        return
+    try:
+        make_agent(spec.name, **spec.config)
+    except (TypeError, ValueError) as exc:
+        raise BenchError(f"--config {spec.name}: {exc}") from None
 
 
 def derive_seed(master_seed: int, run_index: int) -> int:
@@ -157,6 +188,8 @@ def plan_tasks(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], r
     if runs < 1:
         raise BenchError(f"--runs must be >= 1, got {runs}")
     entries = {p.name: _planner_entry(p.name) for p in planners}
+    for p in planners:
+        check_planner_config(p)
     data = [(sc, sc.to_dict(), sc.content_hash()) for sc in scenarios]
     tasks = []
     for i in range(runs):
