@@ -91,7 +91,7 @@ def random_world(seed: int, walls: bool, radius: float = 0.3) -> Problem:
                     shapes.append(_box(x, 0.0, x + t, length))
                 else:
                     shapes.append(_box(x, H - length, x + t, H))
-        n_clutter = int(rng.integers(12, 22 if walls else 30))
+        n_clutter = int(rng.integers(15, 25) if walls else rng.integers(25, 40))
         for _ in range(n_clutter):
             c = rng.uniform([2.0, 0.5], [W - 2.0, H - 0.5])
             kind = rng.integers(0, 3)

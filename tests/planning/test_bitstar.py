@@ -1,6 +1,7 @@
 """BIT*: validity, bounds, anytime monotonicity, determinism, failures, run-time obstacles.
 
 Every budget here is a batch count, not a time, so the assertions are machine-independent.
+Most tests use 100 samples per batch (OMPL's default) to stay fast.
 """
 
 from __future__ import annotations
@@ -24,6 +25,13 @@ from anyplan.planning import (
 )
 from anyplan.world import load_scenario
 
+SPB = 100
+
+
+def bit(problem: Problem, seed, **kw) -> BITStar:  # noqa: ANN001
+    kw.setdefault("samples_per_batch", SPB)
+    return BITStar(problem, rng=seed, **kw)
+
 
 @pytest.fixture(scope="module")
 def peers_lb() -> float:
@@ -33,7 +41,7 @@ def peers_lb() -> float:
 def test_paths_are_collision_free_and_above_the_lower_bound(peers_lb):
     p = peers_problem(0.25)
     for seed in range(3):
-        planner = BITStar(p, rng=seed)
+        planner = bit(p, seed)
         assert planner.solve(batches(40)) is PlannerStatus.EXACT_SOLUTION
         res = planner.result()
         assert p.path_valid(res.path)
@@ -47,7 +55,7 @@ def test_converges_within_five_percent_of_the_optimum(peers_lb):
     """A fixed work budget (about 0.2-0.3 s on the dev machine) reaches <= 1.05 x optimum."""
     p = peers_problem(0.25)
     for seed in (0, 1, 2):
-        planner = BITStar(p, rng=seed)
+        planner = bit(p, seed)
         planner.solve(batches(60))
         assert peers_lb <= planner.best_cost <= 1.05 * peers_lb
 
@@ -56,7 +64,7 @@ def test_converges_within_five_percent_of_the_optimum(peers_lb):
 def test_paper_scenarios_static(scenario):
     sc = load_scenario(scenario)
     p = Problem.create(sc.obstacle_set(), sc.robot.start[:2], sc.robot.goal, sc.robot.radius)
-    planner = BITStar(p, rng=7)
+    planner = bit(p, 7)
     assert planner.solve(batches(30))
     res = planner.result()
     assert p.path_valid(res.path)
@@ -66,7 +74,7 @@ def test_paper_scenarios_static(scenario):
 def test_cost_never_increases_across_solve_calls():
     """OMPL's 2dcircles_optimize property: repeated solve() calls only improve the cost."""
     p = peers_problem(0.25)
-    planner = BITStar(p, rng=4)
+    planner = bit(p, 4)
     costs = []
     for _ in range(25):
         planner.solve(batches(1))
@@ -81,15 +89,15 @@ def test_cost_never_increases_across_solve_calls():
 
 def test_deterministic_for_a_seed():
     p = peers_problem(0.25)
-    a = BITStar(p, rng=np.random.default_rng(11))
-    b = BITStar(p, rng=np.random.default_rng(11))
+    a = bit(p, np.random.default_rng(11))
+    b = bit(p, np.random.default_rng(11))
     a.solve(batches(15))
     b.solve(batches(15))
     ra, rb = a.result(), b.result()
     assert np.array_equal(ra.path, rb.path)
     assert [c for _, c in ra.history] == [c for _, c in rb.history]
     assert ra.stats == rb.stats
-    c = BITStar(p, rng=12)
+    c = bit(p, 12)
     c.solve(batches(15))
     assert not np.array_equal(c.result().path, ra.path)
 
@@ -97,7 +105,7 @@ def test_deterministic_for_a_seed():
 def test_callback_sees_every_improvement():
     seen = []
     p = peers_problem(0.25)
-    planner = BITStar(p, rng=2, callback=lambda t, c, path: seen.append((t, c, path)))
+    planner = bit(p, 2, callback=lambda t, c, path: seen.append((t, c, path)))
     planner.solve(batches(10))
     hist = planner.result().history
     assert [(t, c) for t, c, _ in seen] == hist
@@ -106,7 +114,7 @@ def test_callback_sees_every_improvement():
 
 def test_termination_by_target_cost_and_first_solution():
     p = peers_problem(0.25)
-    planner = BITStar(p, rng=3)
+    planner = bit(p, 3)
     planner.solve(first_solution())
     first = planner.best_cost
     assert math.isfinite(first) and len(planner.result().history) == 1
@@ -116,7 +124,7 @@ def test_termination_by_target_cost_and_first_solution():
 
 def test_k_nearest_mode_finds_valid_paths(peers_lb):
     p = peers_problem(0.25)
-    planner = BITStar(p, rng=5, use_k_nearest=True)
+    planner = bit(p, 5, use_k_nearest=True)
     assert planner.solve(batches(30))
     res = planner.result()
     assert p.path_valid(res.path) and res.cost >= peers_lb - 1e-9
@@ -124,7 +132,7 @@ def test_k_nearest_mode_finds_valid_paths(peers_lb):
 
 def test_infeasible_problem_times_out_without_a_path():
     wall = ObstacleSet([box(4.0, 0.0, 5.0, 10.0)], bounds=(0.0, 0.0, 10.0, 10.0))
-    planner = BITStar(Problem.create(wall, (1.0, 5.0), (8.0, 5.0), 0.2), rng=0)
+    planner = bit(Problem.create(wall, (1.0, 5.0), (8.0, 5.0), 0.2), 0)
     assert planner.solve(batches(5)) is PlannerStatus.TIMEOUT
     res = planner.result()
     assert res.path.shape == (0, 2) and res.cost == math.inf and res.first_solution_time_s is None
@@ -149,7 +157,7 @@ def test_straight_line_problem_stops_at_the_optimum():
 
 def test_add_obstacles_invalidates_only_what_they_block_and_reuses_work():
     p = peers_problem(0.25)
-    planner = BITStar(p, rng=0)
+    planner = bit(p, 0)
     planner.solve(batches(20))
     path = planner.result().path
     blocker = [Circle(path[len(path) // 2], 0.6)]
@@ -166,7 +174,7 @@ def test_add_obstacles_invalidates_only_what_they_block_and_reuses_work():
     assert res.status is PlannerStatus.EXACT_SOLUTION and p2.path_valid(res.path)
     assert res.cost <= target
     reused_checks = planner.stats["n_edge_checks"] - checks_before
-    fresh = BITStar(p2, rng=0)
+    fresh = bit(p2, 0)
     fresh.solve(any_of(target_cost(target), batches(300)))
     assert fresh.best_cost <= target
     assert reused_checks < 0.5 * fresh.stats["n_edge_checks"]
@@ -174,7 +182,7 @@ def test_add_obstacles_invalidates_only_what_they_block_and_reuses_work():
 
 def test_add_obstacles_keeps_an_unblocked_solution():
     p = peers_problem(0.25)
-    planner = BITStar(p, rng=1)
+    planner = bit(p, 1)
     planner.solve(batches(10))
     cost = planner.best_cost
     far = [Polygon([[13.0, 0.5], [14.5, 0.5], [14.5, 1.5]])]  # nowhere near the solution
@@ -187,7 +195,7 @@ def test_add_obstacles_keeps_an_unblocked_solution():
 
 def test_add_obstacles_on_the_goal_reports_it():
     p = peers_problem(0.25)
-    planner = BITStar(p, rng=1)
+    planner = bit(p, 1)
     planner.solve(batches(5))
     planner.add_obstacles([Circle((14.0, 10.0), 0.3)])
     assert planner.solve(batches(2)) is PlannerStatus.INVALID_GOAL

@@ -147,19 +147,50 @@ def _near(v: int, P: np.ndarray, rad: float, cstart: np.ndarray, citems: np.ndar
 
 
 @njit(cache=True)
-def _k_nearest(v: int, P: np.ndarray, n: int, k: int, out: np.ndarray,
-               dout: np.ndarray) -> int:
-    """The k nearest points to v (v excluded), by a linear scan and a partial sort."""
-    d = np.empty(n)
-    for j in range(n):
-        d[j] = math.hypot(P[j, 0] - P[v, 0], P[j, 1] - P[v, 1])
-    d[v] = INF
-    kk = min(k, n - 1)
-    idx = np.argsort(d)[:kk]
-    for t in range(kk):
-        out[t] = idx[t]
-        dout[t] = d[idx[t]]
-    return kk
+def _k_nearest(v: int, P: np.ndarray, k: int, cstart: np.ndarray, citems: np.ndarray,
+               S: np.ndarray, N: np.ndarray, out: np.ndarray, dout: np.ndarray) -> int:
+    """The k nearest points to v (v excluded), searching grid rings outwards.
+
+    Points outside the (2 ring + 1)^2 block of cells around v's cell are farther than
+    ``ring * cell``, so the search stops once k candidates lie within that distance.
+    """
+    x0 = S[S_X0]
+    y0 = S[S_Y0]
+    cell = S[S_CELL]
+    ncx = N[N_NCX]
+    ncy = N[N_NCY]
+    px = P[v, 0]
+    py = P[v, 1]
+    cx = min(max(int((px - x0) / cell), 0), ncx - 1)
+    cy = min(max(int((py - y0) / cell), 0), ncy - 1)
+    ring = 1
+    n_total = N[N_N] - 1
+    kk = min(k, n_total)
+    while True:
+        m = 0
+        for yy in range(max(cy - ring, 0), min(cy + ring + 1, ncy)):
+            for xx in range(max(cx - ring, 0), min(cx + ring + 1, ncx)):
+                c = yy * ncx + xx
+                for t in range(cstart[c], cstart[c + 1]):
+                    j = citems[t]
+                    if j == v:
+                        continue
+                    out[m] = j
+                    dout[m] = math.hypot(P[j, 0] - px, P[j, 1] - py)
+                    m += 1
+        covers_all = (cx - ring <= 0 and cy - ring <= 0 and cx + ring >= ncx - 1
+                      and cy + ring >= ncy - 1)
+        if m >= kk:
+            order = np.argsort(dout[:m])
+            if dout[order[kk - 1]] <= ring * cell or covers_all:
+                idx = out[:m][order[:kk]].copy()
+                dd = dout[:m][order[:kk]].copy()
+                out[:kk] = idx
+                dout[:kk] = dd
+                return kk
+        elif covers_all:
+            return m
+        ring += 1
 
 
 # --- tree helpers -------------------------------------------------------------------------------
@@ -228,10 +259,9 @@ def _expand(v: int, P: np.ndarray, F: np.ndarray, IT: np.ndarray, ek: np.ndarray
     seen_before = IT[v, EXPB] >= 0 and IT[v, EXPB] < N[N_BATCH]
     IT[v, EXPB] = N[N_BATCH]
     N[N_EXP] += 1
-    n = N[N_N]
     batch = N[N_BATCH]
     if N[N_K] > 0:
-        m = _k_nearest(v, P, n, N[N_K], nb, nd)
+        m = _k_nearest(v, P, N[N_K], cstart, citems, S, N, nb, nd)
     elif seen_before and not is_new:
         m = _near(v, P, S[S_R], nstart, nitems, S, N, nb, nd)
     else:
