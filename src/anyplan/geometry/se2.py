@@ -31,13 +31,11 @@ def unicycle_arc(x: float, y: float, theta: float, v: float, omega: float,
     """
     t = np.asarray(t, dtype=float)
     th = theta + omega * t
-    if abs(omega) < 1e-9:
-        # Second-order expansion keeps the formula smooth as omega -> 0.
-        xs = x + v * t * np.cos(theta + 0.5 * omega * t)
-        ys = y + v * t * np.sin(theta + 0.5 * omega * t)
-    else:
-        xs = x + v / omega * (np.sin(th) - math.sin(theta))
-        ys = y - v / omega * (np.cos(th) - math.cos(theta))
+    # Chord form of the arc: exact, and well conditioned as omega -> 0.
+    half = 0.5 * omega * t
+    chord = v * t * np.sinc(half / math.pi)
+    xs = x + chord * np.cos(theta + half)
+    ys = y + chord * np.sin(theta + half)
     if xs.ndim == 0:
         return float(xs), float(ys), float(th)
     return xs, ys, th

@@ -20,7 +20,7 @@ import numpy as np
 __all__ = ["Circle", "Polygon", "Shape", "rectangle", "square", "regular_polygon"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Circle:
     """A disc.
 
@@ -40,6 +40,13 @@ class Circle:
         if not self.radius > 0.0:
             raise ValueError(f"radius must be > 0, got {self.radius}")
 
+    def __eq__(self, other: object) -> bool:
+        return (isinstance(other, Circle) and self.radius == other.radius
+                and bool(np.array_equal(self.center, other.center)))
+
+    def __hash__(self) -> int:
+        return hash((self.center.tobytes(), self.radius))
+
     @property
     def bounds(self) -> tuple[float, float, float, float]:
         """Axis-aligned bounding box (xmin, ymin, xmax, ymax) [m]."""
@@ -52,7 +59,7 @@ class Circle:
         return bool(np.hypot(*(np.asarray(point, float) - self.center)) <= self.radius)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Polygon:
     """A simple polygon, vertices counter-clockwise, shape (N, 2) with N >= 3, in metres."""
 
@@ -75,6 +82,12 @@ class Polygon:
         v.setflags(write=False)
         object.__setattr__(self, "vertices", v)
         object.__setattr__(self, "_area", abs(area2) / 2.0)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Polygon) and bool(np.array_equal(self.vertices, other.vertices))
+
+    def __hash__(self) -> int:
+        return hash(self.vertices.tobytes())
 
     @property
     def area(self) -> float:

@@ -61,14 +61,12 @@ class UnicycleMotion(Motion):
 
     def positions(self, t: np.ndarray) -> np.ndarray:
         tau = np.maximum(np.asarray(t, dtype=float) - self.start_time, 0.0)
-        if self.omega == 0.0:
-            x = self.x0 + self.v * tau * math.cos(self.theta0)
-            y = self.y0 + self.v * tau * math.sin(self.theta0)
-        else:
-            r = self.v / self.omega
-            th = self.theta0 + self.omega * tau
-            x = self.x0 + r * (np.sin(th) - math.sin(self.theta0))
-            y = self.y0 - r * (np.cos(th) - math.cos(self.theta0))
+        # sin(th0 + w t) - sin(th0) = 2 cos(th0 + w t / 2) sin(w t / 2), and likewise for cos:
+        # the chord form below equals the contract's formulas and stays exact as w -> 0.
+        half = 0.5 * self.omega * tau
+        chord = self.v * tau * np.sinc(half / math.pi)
+        x = self.x0 + chord * np.cos(self.theta0 + half)
+        y = self.y0 + chord * np.sin(self.theta0 + half)
         return np.column_stack([np.atleast_1d(x), np.atleast_1d(y)])
 
     def state(self, t: float) -> tuple[float, float, float, float, float]:

@@ -1,0 +1,78 @@
+"""The command line: the result.json contract, pictures, and one-line errors with exit code 2."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from anyplan.cli.main import main
+
+FIELDS = {
+    "scenario": str, "planner": str, "seed": int, "reached_goal": bool, "collision": bool,
+    "path_length_m": float, "planning_times_s": list, "replans": int, "min_clearance_m": float,
+    "trajectory": list,
+}
+
+
+def test_run_writes_the_result_contract_and_picture(tmp_path, capsys):
+    out = tmp_path / "r"
+    assert main(["run", "paper-1", "--planner", "straight", "--seed", "4", "--out", str(out)]) == 0
+    res = json.loads((out / "result.json").read_text())
+    for k, typ in FIELDS.items():
+        assert isinstance(res[k], typ), k
+    assert "time_to_goal_s" in res and res["time_to_goal_s"] is None  # it collides
+    assert res["seed"] == 4 and res["planner"] == "straight" and res["scenario"] == "paper-1"
+    assert all(len(row) == 6 for row in res["trajectory"])
+    png = (out / "run.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
+    assert "collision" in capsys.readouterr().out
+
+
+def test_scenarios_lists_builtins(capsys):
+    assert main(["scenarios"]) == 0
+    out = capsys.readouterr().out
+    assert "paper-1" in out and "paper-3" in out
+
+
+@pytest.mark.parametrize(("argv", "words"), [
+    (["run", "paper-9"], "unknown scenario 'paper-9'"),
+    (["run", "paper-1", "--planner", "strait"], "did you mean 'straight'"),
+    (["run", "missing.yaml"], "missing.yaml: no such file"),
+    (["run", "paper-1", "--dt", "0.5"], "dt must be in"),
+    (["run", "paper-1", "--seed", "x"], "invalid int value"),
+    (["frobnicate"], "invalid choice"),
+])
+def test_bad_input_exits_2_with_one_line(argv, words, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as ei:
+        sys.exit(main(argv))
+    assert ei.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("anyplan: error:")
+    assert words in err
+
+
+def test_bad_scenario_file_names_file_and_field(tmp_path, capsys):
+    f = tmp_path / "s.yaml"
+    f.write_text("name: s\narena: {width: 10, height: 8}\nrobot: {start: [1, 1, 0], goal: [9, 7], "
+                 "radius: -0.3, v_max: 1, omega_max: 1, a_max: 1, alpha_max: 1}\n")
+    assert main(["run", str(f), "--planner", "straight"]) == 2
+    err = capsys.readouterr().err
+    assert f"{f}: robot.radius: must be > 0" in err and err.count("\n") == 1
+
+
+def test_python_dash_m_entry_point(tmp_path):
+    p = subprocess.run([sys.executable, "-m", "anyplan", "run", "nope"], capture_output=True,
+                       text=True, cwd=tmp_path, timeout=120)
+    assert p.returncode == 2
+    assert "Traceback" not in p.stderr and "unknown scenario 'nope'" in p.stderr
+
+
+def test_core_layers_do_not_import_matplotlib():
+    code = ("import sys, anyplan.geometry, anyplan.world, anyplan.agents, anyplan.simulation, "
+            "anyplan.agents.straight; print('matplotlib' in sys.modules)")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert p.stdout.strip() == "False", p.stderr
