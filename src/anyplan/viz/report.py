@@ -243,7 +243,7 @@ def cost_time_figure(db: ResultsDB, path: str | Path) -> Path | None:
                 ax.step(t, c, where="post", color=color, alpha=0.25 if anytime else 0.5, lw=0.8,
                         marker="" if anytime and len(t) > 20 else "o", ms=3)
             if anytime and tmax > tmin:
-                grid = np.linspace(tmin, tmax, 200)
+                grid = np.geomspace(tmin, tmax, 200) if tmin > 0.0 else np.linspace(tmin, tmax, 200)
                 med, lo, hi = _step_median(curves, grid)
                 ax.plot(grid, med, color=color, lw=2, ls="--" if ompl else "-",
                         label=f"{planner} (median of {len(curves)})")
@@ -255,6 +255,9 @@ def cost_time_figure(db: ResultsDB, path: str | Path) -> Path | None:
             t_hi = max((t for (s_, _), runs in by.items() if s_ == scn for v in runs.values() for t, _ in v),
                        default=0.0)
             ax.set_xlim(-0.02 * max(t_hi, 1.0), 1.05 * max(t_hi, 1.0))
+        times = [t for (s_, _), runs in by.items() if s_ == scn for v in runs.values() for t, _ in v]
+        if anytime and times and min(times) > 0.0:  # anytime curves change most early on
+            ax.set_xscale("log")
         ax.set_xlabel("planning time [s]" if anytime else "simulated time [s]")
         ax.set_ylabel("best cost [m]" if anytime else "plan length [m]")
         ax.grid(alpha=0.3)
