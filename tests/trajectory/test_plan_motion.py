@@ -194,3 +194,14 @@ def test_curvature_matched_curve_keeps_points_and_conditions():
         k, _ = c.curvature(np.array([0.0, c.knots[-1]]))
         assert k[0] == pytest.approx(k0, abs=1e-9) and abs(k[1]) < 1e-9
         assert c.heading(np.array([0.0]))[0] == pytest.approx(0.3, abs=1e-12)
+
+
+def test_spinning_in_place_continues_with_the_turn():
+    # At v = 0 while turning at 0.4 rad/s, a smooth start would need omega to jump to 0.
+    spec = load_scenario("paper-1").robot
+    obs = ObstacleSet([], bounds=(0.0, 0.0, 10.0, 6.0))
+    tr = plan_motion(np.array([[2.0, 3.0], [8.0, 3.5]]), spec, RobotState(2.0, 3.0, 0.0, 0.0, 0.4), obs, 0.0)
+    assert tr.kind == "turn+smooth"
+    _, _, _, v, w = tr.sample(np.array([0.0]))
+    assert v[0] == 0.0 and w[0] == pytest.approx(0.4)
+    assert tr.info["candidates"]["smooth"] == math.inf

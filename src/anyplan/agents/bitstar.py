@@ -114,6 +114,7 @@ class BITStarAgent(Agent):
             "motion_time_s": t2 - t1,
             "path_cost_m": float(res.cost),
             "trajectory_kind": traj.kind,
+            "trajectory_certified_free": traj.certified_free,
             "smoothed_length_m": traj.length,
             "reference_duration_s": traj.duration,
             "time_lower_bound_s": traj.lower_bound_s,

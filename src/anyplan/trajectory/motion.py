@@ -126,7 +126,8 @@ def polyline_trajectory(path: np.ndarray, spec: RobotSpec, state: RobotState, t_
 def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles: ObstacleSet,
                 t_start: float, *, margin: float = 0.0, grid_step: float = 0.02,
                 max_repair_rounds: int = 10, allow_turn: bool = True, shortcut: bool = True,
-                shortcut_slack: float = 0.01, start_speed_tolerance: float = 0.01) -> Trajectory:
+                shortcut_slack: float = 0.01, start_speed_tolerance: float = 0.01,
+                start_omega_tolerance: float = 0.05) -> Trajectory:
     """Turn a planned polyline into a timed, collision-free reference motion.
 
     Args:
@@ -151,6 +152,8 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
             this much [m/s] below the robot's speed (the curvature bounds are inflated by 2 %, so
             a robot turning at exactly omega_max would otherwise never qualify); keep it below
             a_max times the control period so the robot matches the reference within one step.
+        start_omega_tolerance: Likewise for the turn rate [rad/s] (keep it below alpha_max
+            times the control period).
 
     Returns:
         The fastest admissible :class:`Trajectory`; ``info`` lists the candidate durations.
@@ -195,6 +198,11 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         # A start speed a little above what the (conservatively bounded) curve admits is
         # absorbed within one control step: accept it up to start_speed_tolerance.
         ok_a = prof.feasible or v0 - float(prof.v[0]) <= start_speed_tolerance
+        # The reference turn rate must also start at the robot's (e.g. not while it spins in
+        # place at v = 0): otherwise the turn-in-place candidate, which starts from omega0, is
+        # the consistent one.
+        k_start, _ = res.curve.curvature(np.array([0.0]))
+        ok_a = ok_a and abs(float(k_start[0]) * float(prof.v[0]) - state.omega) <= start_omega_tolerance
         seg_a = CurveSegment(res.curve, prof, t_start)
         tr = Trajectory([seg_a], kind="smooth", feasible=ok_a,
                         lower_bound_s=time_lower_bound(res.curve.length, spec, v0), polyline=pts,
