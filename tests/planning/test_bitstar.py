@@ -167,6 +167,7 @@ def test_add_obstacles_invalidates_only_what_they_block_and_reuses_work():
     checks_before = planner.stats["n_edge_checks"]
     planner.add_obstacles(blocker)
     assert planner.best_cost == math.inf  # the solution is gone ...
+    assert planner.result().history[-1][1] == math.inf
     assert planner.stats["n_vertices"] > 0.5 * n_vertices  # ... most of the tree is not
     target = 1.03 * lower_bound(p2)
     planner.solve(any_of(target_cost(target), batches(300)))

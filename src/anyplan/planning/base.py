@@ -35,7 +35,8 @@ class PlanResult:
         cost: Path length [m]; ``inf`` without a solution.
         solve_time_s: Cumulative wall-clock time spent in ``solve`` [s].
         first_solution_time_s: Solve time at which the first solution was found [s], or None.
-        history: ``(t_s, cost_m)`` at each improvement, t in cumulative solve time.
+        history: ``(t_s, cost_m)`` at each improvement, t in cumulative solve time (``inf``
+            marks a solution lost to obstacles added at run time).
         lower_bound: A proven lower bound on the optimal cost [m] if known, else None.
         planner: Name of the planner.
         stats: Planner-specific counters (samples, edge checks, batches, ...).
@@ -57,12 +58,16 @@ class PlanResult:
         return bool(self.status)
 
     def cost_at(self, t_s: float) -> float:
-        """Best cost [m] known at solve time ``t_s`` [s] (``inf`` before the first solution)."""
-        best = math.inf
+        """Cost [m] of the solution held at solve time ``t_s`` [s] (``inf`` if none).
+
+        The latest history entry at or before ``t_s``; entries only decrease, except where
+        obstacles were added at run time (an entry ``inf`` marks a lost solution).
+        """
+        cost = math.inf
         for t, c in self.history:
             if t <= t_s:
-                best = min(best, c)
-        return best
+                cost = c
+        return cost
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary (the ``anyplan plan`` output schema)."""
@@ -72,7 +77,8 @@ class PlanResult:
             "path": [[float(x), float(y)] for x, y in np.asarray(self.path).reshape(-1, 2)],
             "first_solution_time_s": self.first_solution_time_s,
             "solve_time_s": float(self.solve_time_s),
-            "history": [[float(t), float(c)] for t, c in self.history],
+            "history": [[float(t), float(c) if math.isfinite(c) else None]
+                        for t, c in self.history],
             "lower_bound": None if self.lower_bound is None else float(self.lower_bound),
             "planner": self.planner,
             "stats": dict(self.stats),

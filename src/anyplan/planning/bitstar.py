@@ -509,8 +509,10 @@ class BITStar(Planner):
         self._path = self._extract_path()
         if self._path.shape[0] and not self._obs.path_free(self._path, self.problem.check_radius):
             raise RuntimeError("internal error: surviving solution collides with new obstacles")
-        t = self._solve_time
-        self._history.append((t, self.best_cost)) if math.isfinite(g_goal) and g_goal != old_cost else None
+        if g_goal != old_cost:
+            # The solution was cut (inf) or rerouted: record it, so that the history stays the
+            # best cost over time (it only decreases between calls to add_obstacles).
+            self._history.append((self._solve_time, g_goal))
         # Re-expand every surviving vertex over the surviving points before sampling more.
         self._batch_open = False
         self._pending_rebatch = True
