@@ -210,3 +210,22 @@ def test_bad_options_raise_naming_the_field():
         BITStar(p, samples_per_batch=0)
     with pytest.raises(ValueError, match="unknown BIT\\* option 'sample_per_batch'"):
         BITStar(p, sample_per_batch=10)
+
+
+@pytest.mark.slow
+def test_one_second_budget_within_five_percent_on_random_worlds():
+    """The issue's wording: <= 1.05 x the bound after 1 s (default settings), fixed seeds."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+    from bitstar import peers, random_world  # benchmarks/bitstar.py
+
+    problems = [peers(0.25), peers(0.0)] + [random_world(i, i % 2 == 1) for i in range(6)]
+    for k, p in enumerate(problems):
+        lb = lower_bound(p)
+        planner = BITStar(p, rng=100 + k)
+        planner.solve(1.0)
+        res = planner.result()
+        assert res.status and p.path_valid(res.path)
+        assert lb - 1e-9 <= res.cost <= 1.05 * lb
