@@ -205,3 +205,23 @@ def test_spinning_in_place_continues_with_the_turn():
     _, _, _, v, w = tr.sample(np.array([0.0]))
     assert v[0] == 0.0 and w[0] == pytest.approx(0.4)
     assert tr.info["candidates"]["smooth"] == math.inf
+
+
+def test_polyline_fallback_from_a_moving_state(limits_checker):
+    spec = load_scenario("paper-1").robot
+    st = RobotState(1.5, 5.5, 0.3, 0.3, 0.2)
+    tr = polyline_trajectory(PAPER_PATH, spec, st, 4.0)
+    assert [s.kind for s in tr.segments][:3] == ["brake", "turn", "curve"]
+    _, _, _, v, w = tr.sample(np.array([4.0]))
+    assert v[0] == pytest.approx(0.3) and w[0] == pytest.approx(0.2)
+    limits_checker(tr, spec)
+
+
+def test_margin_is_reduced_to_the_start_clearance():
+    # The robot starts 5 mm from a wall's inflated boundary; a 2 cm margin cannot be kept there.
+    spec = load_scenario("paper-1").robot
+    obs = ObstacleSet([], bounds=(0.0, 0.0, 10.0, 6.0))
+    st = RobotState(1.0, spec.radius + 0.005, 0.0)
+    tr = plan_motion(np.array([[1.0, 0.305], [9.0, 0.305]]), spec, st, obs, 0.0, margin=0.02)
+    assert tr.certified_free and tr.kind == "smooth"
+    assert dense_clearance(tr, obs) >= spec.radius - 1e-9

@@ -96,8 +96,8 @@ def polyline_trajectory(path: np.ndarray, spec: RobotSpec, state: RobotState, t_
     if brake is not None:
         segs.append(brake)
         t = brake.t1
-        x, y, th, _, _ = (float(v) for v in brake.sample(np.array([t])))
-        x, y, th = float(x), float(y), float(th)
+        bx, by, bth, _, _ = brake.sample(np.array([t]))
+        x, y, th = float(bx[0]), float(by[0]), float(bth[0])
         w = 0.0
     pts = clean_path(path)
     pts = _continue_from(np.array([x, y]), pts, obst, r) if len(pts) >= 2 else np.array([[x, y]])
@@ -138,7 +138,8 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         state: Current robot state (pose and twist).
         obstacles: Obstacles the curve must avoid (static and any virtual ones).
         t_start: Absolute time [s] at which the motion starts.
-        margin: Extra clearance [m] required of the smoothed curve beyond ``spec.radius``.
+        margin: Extra clearance [m] required of the smoothed curve beyond ``spec.radius``
+            (reduced to the robot's current clearance when it is already closer).
         grid_step: Grid spacing [m] of the speed profile and the collision certification.
         max_repair_rounds: Spline repair rounds before the polyline fallback.
         allow_turn: Consider turning in place (disable to force the smooth start).
@@ -161,6 +162,8 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         that itself collides, or a robot too fast for the start of every curve), the best effort
         is returned with ``feasible`` or ``certified_free`` False.
     """
+    # A robot already closer than the margin to an obstacle can only be held to its clearance.
+    margin = min(margin, max(obstacles.clearance((state.x, state.y)) - spec.radius, 0.0))
     radius = spec.radius + margin
     pts = clean_path(path)
     n_input = len(pts)
