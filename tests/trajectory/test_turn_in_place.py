@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from anyplan.geometry import ObstacleSet
 from anyplan.trajectory import plan_motion, rotation_profile
@@ -77,3 +79,20 @@ def test_turn_can_be_disabled():
     path = np.array([[1.0, 2.0], [9.0, 2.0]])
     tr = plan_motion(path, SPEC, RobotState(1.0, 2.0, math.pi / 2), obs, 0.0, allow_turn=False)
     assert tr.kind == "smooth"
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.floats(-7.0, 7.0), st.floats(-0.4, 0.4), st.floats(0.1, 2.0), st.floats(0.2, 3.0))
+def test_rotation_property(dtheta, w0, wmax, amax):
+    w0 = max(-wmax, min(wmax, w0))
+    r = rotation_profile(1.0, dtheta, wmax, amax, omega0=w0)
+    t = np.linspace(0.0, r.duration, 2001)
+    th, w = r.at_time(t)
+    assert th[-1] == pytest.approx(1.0 + dtheta, abs=1e-9)
+    assert abs(w[-1]) < 1e-9 and w[0] == pytest.approx(w0)
+    assert np.abs(w).max() <= wmax + 1e-9
+    if len(t) > 1 and r.duration > 0:
+        assert np.abs(np.diff(w) / np.diff(t)).max() <= amax * (1 + 1e-6)
+    # time-optimal from rest: the closed-form bang-coast-bang duration
+    if w0 == 0.0:
+        assert r.duration == pytest.approx(rest_to_rest_time(dtheta, wmax, amax), rel=1e-9, abs=1e-12)
