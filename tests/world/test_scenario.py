@@ -20,7 +20,8 @@ def test_builtins_are_nested_and_match_table_1():
     for a, b in zip(p, p[1:], strict=False):
         assert a.static_obstacles == b.static_obstacles
         assert a.robot == b.robot
-        assert [o.spec for o in a.moving_obstacles] == [o.spec for o in b.moving_obstacles][:len(a.moving_obstacles)]
+        n = len(a.moving_obstacles)
+        assert [o.spec for o in a.moving_obstacles] == [o.spec for o in b.moving_obstacles][:n]
     r = p[2].robot
     assert (r.v_max, r.omega_max, r.a_max, r.alpha_max) == (0.4, 0.4, 0.4, 1.0)
     assert (p[2].width, p[2].height) == (15.0, 11.0)

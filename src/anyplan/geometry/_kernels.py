@@ -61,8 +61,7 @@ def seg_seg_d2(ax: float, ay: float, bx: float, by: float,
     d = pt_seg_d2(ax, ay, cx, cy, dx, dy)
     d = min(d, pt_seg_d2(bx, by, cx, cy, dx, dy))
     d = min(d, pt_seg_d2(cx, cy, ax, ay, bx, by))
-    d = min(d, pt_seg_d2(dx, dy, ax, ay, bx, by))
-    return d
+    return min(d, pt_seg_d2(dx, dy, ax, ay, bx, by))
 
 
 @njit(cache=True)

@@ -105,12 +105,27 @@ class Scenario:
         out["robot"] = robot
         out["static_obstacles"] = [dict(o.spec) for o in self.static_obstacles]
         out["dynamic_obstacles"] = [dict(o.spec) for o in self.moving_obstacles]
-        return out
+        return _plain(out)
 
     def content_hash(self) -> str:
         """SHA-256 (hex, 16 chars) of the scenario's canonical JSON, ignoring its source."""
         blob = json.dumps(self.to_dict(), sort_keys=True, default=float).encode()
         return hashlib.sha256(blob).hexdigest()[:16]
+
+
+def _plain(obj: Any) -> Any:
+    """Plain Python containers and numbers (numpy scalars and arrays converted), for YAML/JSON."""
+    if isinstance(obj, Mapping):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple | np.ndarray):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.floating):
+        return float(obj)
+    return obj
 
 
 # --------------------------------------------------------------------------------------------

@@ -1,0 +1,274 @@
+"""The ``seq-bitstar`` agent: Sequential BIT* executed online among moving obstacles.
+
+At the start, and whenever a collision with a moving obstacle is predicted on the current
+reference motion, the agent runs :class:`~anyplan.planning.sequential.SequentialBITStar` (the
+paper's Algorithm 1 with our extensions) and takes up the new motion with Kanayama's tracking law.
+
+Planning takes time, and that time passes in the simulation too: a replanning that starts at
+time t plans from the state the robot will have at ``t + d`` on its current reference, where
+``d`` is the expected planning time rounded up to the control period, and the robot keeps
+following its current reference until then. With ``planning_delay="measured"`` (the default)
+``d`` is predicted from the previous planning times and checked against the wall-clock time of
+the actual computation: when the computation took longer, the switch waits for it (the new
+reference then starts slightly behind the robot's pose; Kanayama's law absorbs the offset). A
+fixed ``planning_delay`` in seconds makes runs reproducible for a seed, independent of the
+machine.
+
+Moving obstacles are known through observations only; their motion is predicted with a constant
+twist (:class:`~anyplan.prediction.ConstantTwistPredictor`), which is exact for the paper's
+obstacles. With ``robot.sensing_range`` set, obstacles appear when they come into range and the
+next check replans around them.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from anyplan.agents.base import Agent, AgentStats, Observation
+from anyplan.control.kanayama import KanayamaController, KanayamaGains
+from anyplan.geometry.shapes import Shape
+from anyplan.planning.sequential import SequentialBITStar, SequentialConfig, SequentialResult
+from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
+from anyplan.prediction.collision import first_collision
+from anyplan.trajectory.motion import plan_motion
+from anyplan.trajectory.trajectory import BrakeSegment, Segment, Trajectory
+from anyplan.world.robot import Command, RobotState
+from anyplan.world.scenario import Scenario
+
+__all__ = ["SequentialBITStarAgent", "HoldSegment"]
+
+
+class HoldSegment(Segment):
+    """Standing still at (x, y, theta) from ``t0`` to ``t1`` [s]."""
+
+    kind = "hold"
+
+    def __init__(self, x: float, y: float, theta: float, t0: float, t1: float) -> None:
+        self.x, self.y, self.theta = float(x), float(y), float(theta)
+        self.t0, self.t1 = float(t0), float(t1)
+        self.max_speed = 0.0
+        self.length = 0.0
+
+    def sample(self, t: np.ndarray) -> tuple[np.ndarray, ...]:  # type: ignore[override]
+        t = np.asarray(t, dtype=float)
+        z = np.zeros(t.shape)
+        return np.full(t.shape, self.x), np.full(t.shape, self.y), np.full(t.shape, self.theta), z, z
+
+    def path_points(self, step: float) -> np.ndarray:
+        return np.array([[self.x, self.y]])
+
+
+class SequentialBITStarAgent(Agent):
+    """Sequential BIT* with online replanning.
+
+    Args:
+        config: Settings of the replanning loop (:class:`SequentialConfig`).
+        plan_margin: Extra clearance [m] added to the robot radius for BIT* (static obstacles).
+        smooth_margin: Extra clearance [m] the smoothed curve must keep (< plan_margin).
+        check_period_s: How often [s] the current motion is checked against the predictions.
+        min_replan_interval_s: Minimum time [s] between two replannings (unless the predicted
+            collision is closer than ``urgent_s``).
+        urgent_s: Predicted collisions closer than this [s] replan at once.
+        planning_delay: ``"measured"`` (wall-clock time of the computation) or a fixed delay [s]
+            by which each new motion starts after the replanning decision.
+        grid_step: Grid spacing [m] of the velocity profile and of the curve certification.
+        gains: Kanayama gains.
+    """
+
+    name = "seq-bitstar"
+
+    def __init__(self, config: SequentialConfig | None = None, *, plan_margin: float = 0.03,
+                 smooth_margin: float = 0.015, check_period_s: float = 0.2,
+                 min_replan_interval_s: float = 0.5, urgent_s: float = 3.0,
+                 planning_delay: str | float = "measured", grid_step: float = 0.05,
+                 gains: KanayamaGains | None = None, **loop_options: Any) -> None:
+        super().__init__()
+        if config is None:
+            config = SequentialConfig(**loop_options)
+        elif loop_options:
+            raise ValueError("give either config or loop options, not both")
+        if not 0.0 <= smooth_margin <= plan_margin:
+            raise ValueError("smooth_margin: must be in [0, plan_margin]")
+        if not check_period_s > 0.0:
+            raise ValueError(f"check_period_s: must be > 0, got {check_period_s}")
+        if planning_delay != "measured" and not (isinstance(planning_delay, int | float)
+                                                 and planning_delay >= 0.0):
+            raise ValueError(f"planning_delay: 'measured' or a delay >= 0 s, got {planning_delay!r}")
+        self.config = config
+        self.plan_margin = float(plan_margin)
+        self.smooth_margin = float(smooth_margin)
+        self.check_period_s = float(check_period_s)
+        self.min_replan_interval_s = float(min_replan_interval_s)
+        self.urgent_s = float(urgent_s)
+        self.planning_delay = planning_delay
+        self.grid_step = float(grid_step)
+        self.gains = gains or KanayamaGains()
+
+    # --- lifecycle -------------------------------------------------------------------------------
+    def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
+        self.stats = AgentStats()
+        self.spec = scenario.robot
+        self.obstacles = scenario.obstacle_set()
+        self.rng = rng
+        self.predictor = ConstantTwistPredictor()
+        self.loop = SequentialBITStar(self.obstacles, self.spec.radius,
+                                      self.spec.radius + self.plan_margin, self._motion_unused,
+                                      self.config, rng)
+        self.controller = KanayamaController(self.spec, self.gains, 0.05)
+        self.trajectory: Trajectory | None = None
+        self.pending: tuple[float, Trajectory] | None = None
+        self._dt: float | None = None
+        self._last_t: float | None = None
+        self._last_check = -math.inf
+        self._last_replan = -math.inf
+        self._seen: set[str] = set()
+        self._err_sq = 0.0
+        self._err_n = 0
+        self._err_max = 0.0
+        ex = self.stats.extra
+        ex.update({"statuses": {}, "iterations": [], "late_plans": 0, "plan_time_s": [],
+                   "motion_time_s": [], "replan_times_s": [], "waits": 0})
+
+    @staticmethod
+    def _motion_unused(path: np.ndarray, shapes: Any, delay: float) -> Trajectory:
+        raise RuntimeError("motion_fn is bound per replanning")
+
+    # --- motions ---------------------------------------------------------------------------------
+    def _motion_fn(self, state: RobotState, t_start: float):  # noqa: ANN202
+        spec = self.spec
+        margin = min(self.smooth_margin,
+                     max(self.obstacles.clearance((state.x, state.y)) - spec.radius, 0.0))
+
+        def build(path: np.ndarray, shapes: list[Shape], delay: float) -> Trajectory:
+            obst = self.obstacles.with_shapes(shapes) if shapes else self.obstacles
+            if delay <= 0.0:
+                return plan_motion(path, spec, state, obst, t_start, margin=margin, grid_step=self.grid_step)
+            segs: list[Segment] = []
+            t, x, y, th = t_start, state.x, state.y, state.theta
+            if abs(state.v) > 1e-6 or abs(state.omega) > 1e-6:
+                brake = BrakeSegment(x, y, th, state.v, state.omega, spec.a_max, spec.alpha_max, t)
+                segs.append(brake)
+                t = brake.t1
+                bx, by, bth, _, _ = brake.sample(np.array([t]))
+                x, y, th = float(bx[0]), float(by[0]), float(bth[0])
+            segs.append(HoldSegment(x, y, th, t, t + delay))
+            rest = RobotState(x, y, th, 0.0, 0.0)
+            p = np.asarray(path, dtype=float)
+            here = np.array([x, y])
+            if len(p) >= 2 and obst.segment_free(here, p[1], spec.radius + margin):
+                p = np.vstack([here, p[1:]])
+            tail = plan_motion(p, spec, rest, obst, t + delay, margin=margin, grid_step=self.grid_step)
+            return Trajectory(segs + tail.segments, kind="wait+" + tail.kind, feasible=tail.feasible,
+                              lower_bound_s=tail.lower_bound_s, polyline=tail.polyline,
+                              info=tail.info, certified_free=tail.certified_free)
+
+        return build
+
+    # --- planning --------------------------------------------------------------------------------
+    def _expected_delay(self, dt: float) -> float:
+        if self.planning_delay != "measured":
+            d = float(self.planning_delay)
+        else:
+            recent = self.stats.planning_times_s[-5:]
+            d = 1.5 * max(recent) if recent else 0.05
+        return max(dt, math.ceil(d / dt - 1e-9) * dt)
+
+    def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
+        dt = self._dt or 0.05
+        t = obs.t
+        d = self._expected_delay(dt)
+        t_ready = t + d
+        if self.trajectory is None:
+            r = obs.robot
+            state = RobotState(r.x, r.y, r.theta, r.v, r.omega)
+        else:
+            state = RobotState(*self.trajectory.state(t_ready))
+        self.loop.motion_fn = self._motion_fn(state, t_ready)
+        w0 = time.perf_counter()
+        res: SequentialResult = self.loop.replan(np.array([state.x, state.y]),
+                                                 np.asarray(self.spec.goal, dtype=float), preds, t)
+        wall = time.perf_counter() - w0
+        self._last_replan = t
+        st = self.stats
+        st.planning_times_s.append(wall)
+        if self.trajectory is not None or len(st.planning_times_s) > 1:
+            st.replans += 1
+        ex = st.extra
+        ex["statuses"][res.status] = ex["statuses"].get(res.status, 0) + 1
+        ex["iterations"].append(res.iterations)
+        ex["plan_time_s"].append(res.plan_time_s)
+        ex["motion_time_s"].append(res.motion_time_s)
+        ex["replan_times_s"].append(t)
+        ex.setdefault("reasons", []).append(reason)
+        if res.status == "waiting":
+            ex["waits"] += 1
+        st.virtual_obstacles.extend(v.to_dict() for v in res.virtual_obstacles)
+        if res.motion is None:
+            return  # keep the current reference (or stay put): the next check tries again
+        t_switch = t_ready
+        if self.planning_delay == "measured" and wall > d + 1e-9:
+            ex["late_plans"] += 1
+            t_switch = t + math.ceil(wall / dt - 1e-9) * dt
+        st.plans.append({"t": t, "t_start": t_ready, "path": np.asarray(res.path).tolist(),
+                         "status": res.status, "virtual_obstacles": len(res.virtual_obstacles),
+                         "delay_s": res.delay_s})
+        motion: Trajectory = res.motion  # type: ignore[assignment]
+        if self.trajectory is None:
+            self.trajectory = motion
+            self.pending = None
+        else:
+            self.pending = (t_switch, motion)
+
+    # --- control ---------------------------------------------------------------------------------
+    def act(self, obs: Observation) -> Command:
+        if self._last_t is not None and obs.t > self._last_t:
+            self._dt = obs.t - self._last_t
+            self.controller.dt = self._dt
+        self._last_t = obs.t
+        t = obs.t
+        preds = self.predictor.predict(obs.obstacles)
+        if self.pending is not None and t >= self.pending[0] - 1e-9:
+            self.trajectory = self.pending[1]
+            self.pending = None
+        if self.trajectory is None:
+            self._replan(obs, preds, "initial")
+            self._last_check = t
+            self._seen = {p.name for p in preds}
+        elif self.pending is None and t - self._last_check >= self.check_period_s - 1e-9:
+            self._check(obs, preds)
+        traj = self.trajectory
+        if traj is None:
+            return Command(0.0, 0.0)
+        x, y, _, _, _ = traj.state(t)
+        err = math.hypot(x - obs.robot.x, y - obs.robot.y)
+        self._err_sq += err * err
+        self._err_n += 1
+        self._err_max = max(self._err_max, err)
+        self.stats.extra["tracking_rms_m"] = math.sqrt(self._err_sq / self._err_n)
+        self.stats.extra["tracking_max_m"] = self._err_max
+        return self.controller.command(traj, obs.robot, t)
+
+    def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
+        t = obs.t
+        self._last_check = t
+        traj = self.trajectory
+        assert traj is not None
+        names = {p.name for p in preds}
+        new = names - self._seen
+        self._seen |= names
+        if t >= traj.t_end and math.hypot(obs.robot.x - self.spec.goal[0],
+                                          obs.robot.y - self.spec.goal[1]) <= self.spec.goal_tolerance:
+            return
+        hit = first_collision(traj, preds, self.spec.radius, t_from=t,
+                              t_until=max(traj.t_end, t) + 1.0, margin=0.5 * self.config.margin,
+                              sample_dt=self.config.prediction_dt)
+        if hit is None:
+            return
+        urgent = hit.t - t < self.urgent_s
+        if not urgent and not new and t - self._last_replan < self.min_replan_interval_s:
+            return
+        self._replan(obs, preds, f"collision with {hit.obstacle} predicted at {hit.t:.2f} s")

@@ -1,0 +1,359 @@
+"""Sequential BIT*: plan among static obstacles, then add virtual obstacles where moving ones hit.
+
+Roy, Harchowdhury & Vachhani, "Anytime Planning: A Motion Planner for Dynamic Environment"
+(Algorithm 1). Given the robot's state, the static world and the predicted motions of the moving
+obstacles:
+
+1. plan a shortest path with BIT* (:class:`~anyplan.planning.bitstar.BITStar`);
+2. turn it into a timed reference motion (smoothing and velocity profile; injected here as
+   ``motion_fn`` so that this module stays below the trajectory layer);
+3. predict, continuously in time, the first collision with any moving obstacle
+   (:func:`anyplan.prediction.collision.first_collision`);
+4. if there is one, add a *virtual static obstacle* there: an axis-aligned square of side
+   ``2 (r_robot + r_obstacle)`` centred at the robot's reference position at the predicted
+   collision, and plan again (step 1);
+5. otherwise return the collision-free path, its motion and the virtual obstacles.
+
+What we do beyond the paper (each documented in ``docs/sequential.md``):
+
+* **Continued search.** After a square is added, BIT* continues from its current graph
+  (:meth:`BITStar.add_obstacles` invalidates only what the square blocks) instead of
+  starting over (``warm_start``); ``benchmarks/replan.py`` measures both.
+* **Squares at the start or the goal are shrunk** (kept centred, side reduced) until the robot
+  fits at the start and at the goal; a square that would have to shrink below ``min_side`` is
+  not added and that attempt counts as blocked.
+* **Waiting.** When the loop cannot find a collision-free motion within ``max_iterations`` (or
+  is blocked), the robot may wait: the paths found are tried again with the departure delayed
+  by each of ``wait_delays_s``. This keeps the robot safe where no detour exists in time.
+
+Notation: r robot radius [m], r_o obstacle radius [m], c collision point [m], s square side [m].
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
+from anyplan.geometry.shapes import Shape, square
+from anyplan.planning.bitstar import BITStar, BITStarConfig
+from anyplan.planning.problem import Problem
+from anyplan.planning.termination import any_of, batches, first_solution, timed
+from anyplan.prediction.base import PredictedObstacle
+from anyplan.prediction.collision import PredictedCollision, TimedMotion, first_collision
+
+__all__ = ["SequentialConfig", "VirtualObstacle", "SequentialResult", "SequentialBITStar",
+           "shrink_square"]
+
+#: ``motion_fn(path, extra_shapes, delay_s)``: the timed reference motion along ``path`` (N, 2)
+#: among the static obstacles plus ``extra_shapes``, departing ``delay_s`` seconds late.
+MotionFn = Callable[[np.ndarray, Sequence[Shape], float], TimedMotion]
+
+
+@dataclass(frozen=True)
+class SequentialConfig:
+    """Settings of the Sequential BIT* loop (times in s, lengths in m).
+
+    Attributes:
+        max_iterations: Cap on BIT* plans per replanning (the paper needed about 3).
+        first_budget_s: BIT* budget of the first plan (among the static obstacles).
+        iteration_budget_s: BIT* budget after each virtual obstacle is added.
+        batches_per_plan: If set, each plan stops after this many batches (after a first
+            solution) instead of a time budget: the search is then deterministic for a seed.
+        warm_start: Continue the previous search after adding a square (else start anew).
+        margin: Extra clearance [m] required between the robot's reference and an obstacle in
+            the prediction (absorbs the tracking error).
+        side_factor: Square side = ``side_factor * 2 (r + r_o)``; 1.0 is the paper's size.
+        min_side: Smallest side [m] a shrunk square may keep.
+        anchor: Where the square is centred: ``"robot"`` (the paper: the robot's reference
+            position at the collision), ``"obstacle"`` (the obstacle's centre then) or
+            ``"midpoint"``.
+        wait_delays_s: Departure delays tried when the loop fails.
+        prediction_dt: The motion is resampled every ``prediction_dt`` seconds for the
+            collision prediction (certified: the contact distance is enlarged by the
+            interpolation error bound, at most v_max * prediction_dt / 2); None predicts on the
+            motion itself (slower).
+        bitstar: BIT* settings.
+    """
+
+    max_iterations: int = 8
+    first_budget_s: float = 0.02
+    iteration_budget_s: float = 0.005
+    batches_per_plan: int | None = None
+    warm_start: bool = True
+    margin: float = 0.05
+    side_factor: float = 1.0
+    min_side: float = 0.1
+    anchor: str = "robot"
+    wait_delays_s: tuple[float, ...] = (0.5, 1.0, 2.0, 3.0, 5.0, 8.0, 12.0)
+    prediction_dt: float | None = 0.02
+    bitstar: BITStarConfig = field(default_factory=BITStarConfig)
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.max_iterations, int) and self.max_iterations >= 1):
+            raise ValueError(f"max_iterations: must be an int >= 1, got {self.max_iterations!r}")
+        for name in ("first_budget_s", "iteration_budget_s", "side_factor", "min_side"):
+            if not float(getattr(self, name)) > 0.0:
+                raise ValueError(f"{name}: must be > 0, got {getattr(self, name)!r}")
+        if self.margin < 0.0:
+            raise ValueError(f"margin: must be >= 0, got {self.margin!r}")
+        if self.anchor not in ("robot", "obstacle", "midpoint"):
+            raise ValueError(f"anchor: must be robot, obstacle or midpoint, got {self.anchor!r}")
+        if self.batches_per_plan is not None and self.batches_per_plan < 1:
+            raise ValueError(f"batches_per_plan: must be >= 1, got {self.batches_per_plan!r}")
+        if any(d <= 0.0 for d in self.wait_delays_s):
+            raise ValueError("wait_delays_s: delays must be > 0")
+
+
+@dataclass(frozen=True)
+class VirtualObstacle:
+    """A virtual static square.
+
+    Attributes:
+        center: (x, y) [m].
+        side: Side [m] (after any shrinking).
+        created_at_s: Time of the replanning that created it [s].
+        collision_time_s: Predicted collision time [s] that it stands for.
+        obstacle: Name of the moving obstacle.
+        shrunk: True if the side was reduced so that the robot fits at the start or the goal.
+    """
+
+    center: tuple[float, float]
+    side: float
+    created_at_s: float
+    collision_time_s: float
+    obstacle: str
+    shrunk: bool = False
+
+    @property
+    def shape(self) -> Shape:
+        """The square as a polygon."""
+        return square(self.center, self.side)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``result.json`` form ``{center, side, created_at_s, ...}``."""
+        return {"center": [float(self.center[0]), float(self.center[1])], "side": float(self.side),
+                "created_at_s": float(self.created_at_s),
+                "collision_time_s": float(self.collision_time_s), "obstacle": self.obstacle,
+                "shrunk": bool(self.shrunk)}
+
+
+@dataclass
+class SequentialResult:
+    """Outcome of one Sequential BIT* replanning.
+
+    Attributes:
+        status: ``"collision_free"``, ``"waiting"`` (collision-free after a delayed departure),
+            ``"collision_predicted"`` (no collision-free motion found; the best effort is
+            returned), ``"plan_failed"`` (BIT* found no path) or ``"invalid_start"``.
+        path: The chosen path (N, 2) [m] (empty when planning failed).
+        motion: Its timed reference motion (None when planning failed).
+        virtual_obstacles: The squares added in this replanning.
+        iterations: BIT* plans made.
+        delay_s: Departure delay of the chosen motion [s].
+        collision: The first predicted collision of the returned motion, if any.
+        plan_time_s: Wall-clock time of the BIT* searches [s].
+        motion_time_s: Wall-clock time spent building motions and predicting [s].
+        costs: Path cost [m] of each plan.
+    """
+
+    status: str
+    path: np.ndarray
+    motion: TimedMotion | None
+    virtual_obstacles: list[VirtualObstacle]
+    iterations: int
+    delay_s: float = 0.0
+    collision: PredictedCollision | None = None
+    plan_time_s: float = 0.0
+    motion_time_s: float = 0.0
+    costs: list[float] = field(default_factory=list)
+
+    @property
+    def collision_free(self) -> bool:
+        """True if the returned motion is predicted collision-free."""
+        return self.status in ("collision_free", "waiting")
+
+
+def _box_distance(p: np.ndarray, center: np.ndarray, half: float) -> float:
+    d = np.maximum(np.abs(p - center) - half, 0.0)
+    return float(math.hypot(d[0], d[1]))
+
+
+def shrink_square(center: np.ndarray, side: float, keep_clear: Sequence[np.ndarray],
+                  clearance: float) -> float:
+    """Largest side <= ``side`` [m] such that the square centred at ``center`` stays at least
+    ``clearance`` [m] away from every point of ``keep_clear``; 0 if none exists.
+
+    Examples:
+        >>> round(shrink_square(np.array([0.0, 0.0]), 2.0, [np.array([1.5, 0.0])], 0.3), 6)
+        2.0
+        >>> round(shrink_square(np.array([0.0, 0.0]), 2.0, [np.array([1.0, 0.0])], 0.3), 6)
+        1.4
+    """
+    half = side / 2.0
+    for p in keep_clear:
+        # The distance to an axis-aligned box decreases with its half side h; it is
+        # ||max(|p - c| - h, 0)||, so the largest admissible h is found by bisection.
+        if _box_distance(p, center, half) >= clearance:
+            continue
+        lo, hi = 0.0, half
+        if _box_distance(p, center, 0.0) < clearance:
+            return 0.0
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            if _box_distance(p, center, mid) >= clearance:
+                lo = mid
+            else:
+                hi = mid
+        half = lo
+    return 2.0 * half
+
+
+class SequentialBITStar:
+    """The Sequential BIT* replanning loop (the paper's Algorithm 1, with our extensions).
+
+    Args:
+        obstacles: Static obstacles with the arena walls.
+        robot_radius: [m].
+        plan_radius: Radius [m] BIT* plans for (robot radius plus a planning margin).
+        motion_fn: Builds the timed motion along a path (see :data:`MotionFn`).
+        config: Loop settings.
+        rng: Random generator of BIT*.
+    """
+
+    def __init__(self, obstacles: ObstacleSet, robot_radius: float, plan_radius: float,
+                 motion_fn: MotionFn, config: SequentialConfig | None = None,
+                 rng: np.random.Generator | None = None) -> None:
+        self.obstacles = obstacles
+        self.robot_radius = float(robot_radius)
+        self.plan_radius = float(plan_radius)
+        self.motion_fn = motion_fn
+        self.config = config or SequentialConfig()
+        self.rng = rng if rng is not None else np.random.default_rng()
+
+    # --- one BIT* search ---------------------------------------------------------------------------
+    def _budget(self, first: bool) -> Any:
+        cfg = self.config
+        if cfg.batches_per_plan is not None:
+            return any_of(batches(cfg.batches_per_plan) & first_solution(), timed(10.0))
+        budget = cfg.first_budget_s if first else cfg.iteration_budget_s
+        # At least a first solution: keep searching (up to 20 budgets) until one exists.
+        return any_of(timed(budget) & first_solution(), timed(20.0 * budget))
+
+    def replan(self, start: np.ndarray, goal: np.ndarray, predictions: Sequence[PredictedObstacle],
+               t_now: float) -> SequentialResult:
+        """Plan from ``start`` to ``goal`` until the predicted motion is collision-free.
+
+        Args:
+            start: Position (x, y) [m] where the new motion starts.
+            goal: Goal (x, y) [m].
+            predictions: Predicted moving obstacles (absolute times).
+            t_now: Time [s] stamped on the virtual obstacles created.
+        """
+        cfg = self.config
+        start = np.asarray(start, dtype=float)
+        goal = np.asarray(goal, dtype=float)
+        squares: list[VirtualObstacle] = []
+        candidates: list[tuple[np.ndarray, list[Shape]]] = []
+        plan_time = motion_time = 0.0
+        costs: list[float] = []
+        problem = Problem.create(self.obstacles, start, goal, self.plan_radius)
+        if not problem.start_valid():
+            # Hugging an obstacle: plan for the robot itself, without the planning margin.
+            problem = Problem.create(self.obstacles, start, goal, self.robot_radius)
+            if not problem.start_valid():
+                return SequentialResult("invalid_start", np.zeros((0, 2)), None, [], 0)
+        planner = BITStar(problem, cfg.bitstar, rng=self.rng)
+        best: SequentialResult | None = None
+        blocked = False
+        status = "collision_predicted"
+        for it in range(cfg.max_iterations):
+            t0 = time.perf_counter()
+            if not cfg.warm_start and it > 0:
+                planner = BITStar(problem.with_shapes([s.shape for s in squares]), cfg.bitstar,
+                                  rng=self.rng)
+            planner.solve(self._budget(it == 0))
+            res = planner.result()
+            plan_time += time.perf_counter() - t0
+            if not res.solved:
+                status = "plan_failed"
+                break
+            costs.append(float(res.cost))
+            t1 = time.perf_counter()
+            shapes = [s.shape for s in squares]
+            motion = self.motion_fn(res.path, shapes, 0.0)
+            hit = first_collision(motion, predictions, self.robot_radius, margin=cfg.margin,
+                                  sample_dt=cfg.prediction_dt)
+            motion_time += time.perf_counter() - t1
+            candidates.append((res.path, shapes))
+            attempt = SequentialResult("collision_free" if hit is None else "collision_predicted",
+                                       res.path, motion, list(squares), it + 1, 0.0, hit)
+            if hit is None:
+                attempt.plan_time_s, attempt.motion_time_s, attempt.costs = plan_time, motion_time, costs
+                return attempt
+            if best is None or hit.t > best.collision.t:  # type: ignore[union-attr]
+                best = attempt
+            vo = self._virtual_obstacle(hit, start, goal, t_now)
+            if vo is None:
+                blocked = True
+                break
+            squares.append(vo)
+            if cfg.warm_start:
+                planner.add_obstacles([vo.shape])
+        # Algorithm 1 did not converge: try waiting before departing on the paths found.
+        t1 = time.perf_counter()
+        waited = self._try_waiting(candidates, predictions)
+        motion_time += time.perf_counter() - t1
+        if waited is not None:
+            path, shapes, delay, motion = waited
+            n = len(shapes)
+            return SequentialResult("waiting", path, motion, squares[:n], len(costs), delay, None,
+                                    plan_time, motion_time, costs)
+        if best is None:
+            return SequentialResult(status if not blocked else "plan_failed", np.zeros((0, 2)), None,
+                                    squares, len(costs), plan_time_s=plan_time,
+                                    motion_time_s=motion_time, costs=costs)
+        best.status = "collision_predicted"
+        best.iterations = len(costs)
+        best.plan_time_s, best.motion_time_s, best.costs = plan_time, motion_time, costs
+        return best
+
+    def _virtual_obstacle(self, hit: PredictedCollision, start: np.ndarray, goal: np.ndarray,
+                          t_now: float) -> VirtualObstacle | None:
+        cfg = self.config
+        if cfg.anchor == "robot":
+            c = hit.robot_position
+        elif cfg.anchor == "obstacle":
+            c = hit.obstacle_position
+        else:
+            c = 0.5 * (hit.robot_position + hit.obstacle_position)
+        side = cfg.side_factor * 2.0 * (self.robot_radius + hit.obstacle_radius)
+        # The robot must fit at the start and at the goal: shrink the square if needed.
+        need = self.plan_radius + 1e-6 + COLLISION_EPS
+        s = shrink_square(np.asarray(c), side, [start, goal], need)
+        if s < cfg.min_side:
+            return None
+        return VirtualObstacle((float(c[0]), float(c[1])), s, float(t_now), hit.t, hit.obstacle,
+                               s < side)
+
+    def _try_waiting(self, candidates: list[tuple[np.ndarray, list[Shape]]],
+                     predictions: Sequence[PredictedObstacle]
+                     ) -> tuple[np.ndarray, list[Shape], float, TimedMotion] | None:
+        if not candidates:
+            return None
+        # Shortest paths first, and among equals the ones with fewer squares.
+        order = sorted(range(len(candidates)),
+                       key=lambda i: (float(np.sum(np.hypot(*np.diff(candidates[i][0], axis=0).T))), i))
+        for delay in self.config.wait_delays_s:
+            for i in order:
+                path, shapes = candidates[i]
+                motion = self.motion_fn(path, shapes, delay)
+                if first_collision(motion, predictions, self.robot_radius, margin=self.config.margin,
+                                   sample_dt=self.config.prediction_dt) is None:
+                    return path, shapes, delay, motion
+        return None
