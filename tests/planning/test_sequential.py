@@ -1,0 +1,129 @@
+"""The Sequential BIT* loop (the paper's Algorithm 1 and our extensions)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from anyplan.agents.sequential import SequentialBITStarAgent
+from anyplan.geometry import ObstacleSet, rectangle
+from anyplan.planning.sequential import SequentialBITStar, SequentialConfig, shrink_square
+from anyplan.prediction import ConstantTwistPredictor, PredictedObstacle
+from anyplan.simulation.simulator import observe
+from anyplan.trajectory.motion import plan_motion
+from anyplan.world import RobotState, UnicycleMotion, load_scenario
+
+
+def _loop(scenario, cfg=None, seed=0):
+    spec = scenario.robot
+    obstacles = scenario.obstacle_set()
+    state = RobotState(*spec.start, 0.0, 0.0)
+
+    def motion_fn(path, shapes, delay):
+        obst = obstacles.with_shapes(shapes) if shapes else obstacles
+        # The robot is at rest at the start: waiting is simply departing later.
+        return plan_motion(path, spec, state, obst, delay, margin=0.015)
+
+    loop = SequentialBITStar(obstacles, spec.radius, spec.radius + 0.03, motion_fn,
+                             cfg or SequentialConfig(), np.random.default_rng(seed))
+    preds = ConstantTwistPredictor().predict(observe(scenario, 0.0, state))
+    return loop, preds, state
+
+
+def _dense_clearance(motion, scenario, t_step=0.01):
+    t = np.arange(motion.t_start, motion.t_end + t_step, t_step)
+    p = motion.positions(t)
+    gaps = [np.hypot(*(p - o.motion.positions(t)).T) - o.radius - scenario.robot.radius
+            for o in scenario.moving_obstacles]
+    return min(float(g.min()) for g in gaps)
+
+
+@pytest.mark.parametrize("name", ["paper-1", "paper-2", "paper-3"])
+@pytest.mark.parametrize("warm", [True, False])
+def test_loop_returns_a_motion_that_clears_every_moving_obstacle(name, warm):
+    sc = load_scenario(name)
+    loop, preds, _ = _loop(sc, SequentialConfig(warm_start=warm, prediction_dt=None))
+    res = loop.replan(np.array(sc.robot.start[:2]), np.array(sc.robot.goal), preds, 0.0)
+    assert res.collision_free and res.status == "collision_free"
+    assert res.iterations == len(res.costs) >= 2  # the straight route collides first
+    assert len(res.virtual_obstacles) == res.iterations - 1
+    # Independent check on the true motions: the margin (0.05 m) is kept, up to the dense step.
+    assert _dense_clearance(res.motion, sc) >= loop.config.margin - 0.4 * 0.01 - 1e-9
+    # The path avoids the static obstacles and every virtual square exactly.
+    obst = sc.obstacle_set().with_shapes([v.shape for v in res.virtual_obstacles])
+    assert obst.path_free(res.path, sc.robot.radius)
+    for v in res.virtual_obstacles:
+        assert v.side == pytest.approx(2 * (0.3 + 0.3)) or v.shrunk
+
+
+def test_squares_are_centred_on_the_robot_reference_at_the_collision():
+    sc = load_scenario("paper-1")
+    loop, preds, _ = _loop(sc, SequentialConfig(prediction_dt=None))
+    res = loop.replan(np.array(sc.robot.start[:2]), np.array(sc.robot.goal), preds, 0.0)
+    v = res.virtual_obstacles[0]
+    assert v.obstacle == "D1"
+    # The first plan is the straight line y = 5.5: the robot meets D1 there, before x = 5.
+    assert v.center[1] == pytest.approx(5.5, abs=1e-6)
+    assert 3.5 < v.center[0] < 5.0
+    assert v.collision_time_s > 0.0
+
+
+def test_shrink_square_keeps_the_robot_clear():
+    rng = np.random.default_rng(1)
+    for _ in range(500):
+        c = rng.uniform(-2, 2, 2)
+        pts = [rng.uniform(-2, 2, 2) for _ in range(2)]
+        side = shrink_square(c, 1.2, pts, 0.33)
+        assert 0.0 <= side <= 1.2
+        if side > 0.0:
+            box = ObstacleSet([rectangle(c, (side, side))])
+            for p in pts:
+                assert box.clearance(p) >= 0.33 - 1e-6
+            # Maximal: a slightly larger square would touch one of the points (or side is 1.2).
+            if side < 1.2 - 1e-9:
+                bigger = ObstacleSet([rectangle(c, (side + 1e-4, side + 1e-4))])
+                assert min(bigger.clearance(p) for p in pts) < 0.33
+
+
+def test_unreachable_goal_is_a_clear_failure():
+    sc = load_scenario("paper-1")
+    wall = rectangle((10.0, 5.5), (0.4, 11.0))
+    obst = sc.obstacle_set().with_shapes([wall])
+    spec = sc.robot
+
+    def motion_fn(path, shapes, delay):
+        raise AssertionError("no path exists, so no motion is built")
+
+    cfg = SequentialConfig(first_budget_s=0.05)
+    loop = SequentialBITStar(obst, spec.radius, spec.radius + 0.03, motion_fn, cfg,
+                             np.random.default_rng(0))
+    res = loop.replan(np.array(spec.start[:2]), np.array(spec.goal), [], 0.0)
+    assert res.status == "plan_failed" and res.motion is None and len(res.path) == 0
+
+
+def test_obstacle_parked_on_the_goal_makes_the_robot_wait_or_report():
+    sc = load_scenario("paper-1")
+    spec = sc.robot
+    # A slow obstacle crossing the goal about when the robot arrives: no detour can help, but a
+    # later arrival can; the squares are shrunk so the goal stays reachable.
+    parked = PredictedObstacle("G", 0.3, UnicycleMotion(13.5, 2.0, np.pi / 2, 0.12))
+    loop, _, _ = _loop(sc, SequentialConfig(prediction_dt=None))
+    res = loop.replan(np.array(spec.start[:2]), np.array(spec.goal), [parked], 0.0)
+    assert res.status in ("collision_free", "waiting", "collision_predicted")
+    for v in res.virtual_obstacles:
+        box = ObstacleSet([v.shape])
+        assert box.clearance(spec.goal) >= spec.radius
+        assert box.clearance(spec.start[:2]) >= spec.radius
+    if res.collision_free:
+        t = np.arange(res.motion.t_start, res.motion.t_end, 0.01)
+        gap = np.hypot(*(res.motion.positions(t) - parked.positions(t)).T) - 0.6
+        assert gap.min() >= 0.05 - 0.004
+
+
+def test_config_validation_names_the_field():
+    with pytest.raises(ValueError, match="max_iterations"):
+        SequentialConfig(max_iterations=0)
+    with pytest.raises(ValueError, match="anchor"):
+        SequentialConfig(anchor="centre")
+    with pytest.raises(ValueError, match="planning_delay"):
+        SequentialBITStarAgent(planning_delay="soon")

@@ -1,0 +1,73 @@
+"""Predicted collisions of a timed reference motion against brute-force dense sampling."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from anyplan.geometry import ObstacleSet
+from anyplan.prediction import PredictedObstacle
+from anyplan.prediction.collision import SampledMotion, first_collision, predict_collisions
+from anyplan.trajectory.motion import plan_motion
+from anyplan.world import RobotSpec, RobotState, UnicycleMotion
+
+SPEC = RobotSpec(start=(1.0, 5.0, 0.0), goal=(14.0, 5.0))
+ARENA = ObstacleSet([], bounds=(0.0, 0.0, 15.0, 11.0))
+
+
+def _motion(mid_y: float):
+    path = np.array([[1.0, 5.0], [7.5, mid_y], [14.0, 5.0]])
+    return plan_motion(path, SPEC, RobotState(1.0, 5.0, 0.0), ARENA, 0.0)
+
+
+def _dense_first(motion, obstacle, reach, t1, dt=1e-3):
+    t = np.arange(0.0, t1, dt)
+    d = np.hypot(*(motion.positions(t) - obstacle.positions(t)).T)
+    hit = np.nonzero(d <= reach)[0]
+    return (t[hit[0]] if len(hit) else None), d
+
+
+MOTIONS = {y: _motion(y) for y in (3.5, 5.0, 6.5)}
+
+
+@settings(max_examples=40, deadline=None)
+@given(mid=st.sampled_from([3.5, 5.0, 6.5]), x0=st.floats(3.0, 12.0), y0=st.floats(1.0, 9.0),
+       th=st.floats(-3.2, 3.2), v=st.floats(0.05, 0.3), om=st.sampled_from([0.0, -0.14, 0.2]),
+       sample_dt=st.sampled_from([None, 0.02, 0.05]))
+def test_first_collision_is_never_late_and_tight(mid, x0, y0, th, v, om, sample_dt):
+    motion = MOTIONS[mid]
+    ob = PredictedObstacle("D", 0.3, UnicycleMotion(x0, y0, th, v, om))
+    reach = 0.6
+    hit = first_collision(motion, [ob], 0.3, sample_dt=sample_dt, t_until=motion.t_end)
+    t_ref, d = _dense_first(motion, ob, reach, motion.t_end)
+    if t_ref is not None:
+        assert hit is not None and hit.t <= t_ref + 1e-9
+        if sample_dt is None:
+            # Exact up to the search tolerance (1e-4 s) and the sampling of the reference (1 ms).
+            assert hit.t >= t_ref - 1e-3 - 1e-4 - 1e-9
+    if hit is not None:
+        # The reported place is where the robot's reference is at that time.
+        np.testing.assert_allclose(hit.robot_position, motion.positions(np.array([hit.t]))[0], atol=1e-9)
+        if sample_dt is None:
+            assert np.hypot(*(hit.robot_position - hit.obstacle_position)) <= reach + 1e-3
+    else:
+        assert d.min() > reach
+
+
+def test_resampled_motion_error_bound_holds():
+    motion = MOTIONS[6.5]
+    sm = SampledMotion(motion, 0.0, motion.t_end, 0.05)
+    t = np.linspace(0.0, motion.t_end, 20001)
+    err = np.hypot(*(sm.positions(t) - motion.positions(t)).T)
+    assert err.max() <= sm.error_bound + 1e-12
+
+
+def test_collisions_are_sorted_and_per_obstacle():
+    motion = MOTIONS[5.0]
+    obs = [PredictedObstacle("late", 0.3, UnicycleMotion(11.0, 10.1, -np.pi / 2, 0.2)),
+           PredictedObstacle("early", 0.3, UnicycleMotion(4.0, 4.04, np.pi / 2, 0.12)),
+           PredictedObstacle("never", 0.3, UnicycleMotion(1.0, 10.0, 0.0, 0.1))]
+    hits = predict_collisions(motion, obs, 0.3)
+    assert [h.obstacle for h in hits] == ["early", "late"]
+    assert hits[0].t < hits[1].t
