@@ -2,7 +2,9 @@
 
 The paper (Roy, Harchowdhury & Vachhani, "Anytime Planning: A Motion Planner for Dynamic
 Environment", §4) turns BIT*'s polyline into a smooth curve with a cubic spline. Here the spline
-interpolates the path's points with ``scipy.interpolate.CubicSpline`` and is parameterised by arc
+interpolates the path's points (the C2 interpolating cubic that ``scipy.interpolate.CubicSpline``
+would give, solved by our own tridiagonal numba kernel in :mod:`anyplan.trajectory._kernels` and
+evaluated there from its piecewise-polynomial coefficients) and is parameterised by arc
 length: a first fit uses chord lengths as knots, which are then replaced (twice) by the arc
 lengths of the previous fit; finally the fit is resampled at short parameter steps, every sample
 (the interpolation points among them) gets its exact arc length (Gauss-Legendre quadrature) as
@@ -41,9 +43,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import CubicSpline, make_interp_spline
 
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
+from anyplan.trajectory import _kernels as _k
 
 __all__ = [
     "SmoothCurve",
@@ -55,9 +57,9 @@ __all__ = [
 ]
 
 # Gauss-Legendre nodes/weights on [0, 1] (5 points: exact for polynomials of degree 9).
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(5)
-_GL_X = 0.5 * (_GL_X + 1.0)
-_GL_W = 0.5 * _GL_W
+_GL_X, _GL_W = _k.GL_X, _k.GL_W
+# Sub-sample fractions of a piece used to estimate its tangent turn.
+_FR9 = np.linspace(0.0, 1.0, 9)
 
 #: Distance [m] of the extra knot from the start when a start curvature is imposed.
 START_KNOT = 0.5
@@ -155,8 +157,8 @@ class SmoothCurve:
         start_curvature: With ``start_heading``, also the signed curvature [1/m] at the start,
             so that a robot already turning at omega = kappa v can take up the curve without a
             jump in its turn rate. This needs one more degree of freedom than a cubic spline
-            through the points has: a C2 cubic B-spline (``scipy.interpolate.make_interp_spline``)
-            with one extra knot in the first interval is used instead.
+            through the points has: the C2 cubic gets one extra knot in the first interval (the
+            curve ``scipy.interpolate.make_interp_spline`` builds with that knot vector).
         grid_step: Target spacing [m] of the evaluation grid used for arc length tables,
             speed profiles and collision certification (finer where the tangent turns by more
             than ``MAX_TURN`` across a step).
@@ -175,7 +177,7 @@ class SmoothCurve:
     def __init__(self, points: np.ndarray, start_heading: float | None = None,
                  grid_step: float = 0.02, reparam_iters: int = 2,
                  resample_step: float = 0.05, start_curvature: float | None = None) -> None:
-        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        pts = np.ascontiguousarray(np.asarray(points, dtype=float).reshape(-1, 2))
         if len(pts) < 2:
             raise ValueError("a curve needs at least two points")
         chords = np.hypot(*np.diff(pts, axis=0).T)
@@ -184,95 +186,79 @@ class SmoothCurve:
         self.points = pts
         self.start_heading = start_heading
         self.start_curvature = start_curvature if start_heading is not None else None
-        if start_heading is None:
-            bc: object = "natural"
-        else:
+        tan = np.zeros(2)
+        nrm = np.zeros(2)
+        mode = 0
+        if start_heading is not None:
             tan = np.array([math.cos(start_heading), math.sin(start_heading)])
-            bc = ((1, tan), (2, np.zeros(2)))
+            mode = 1
             if self.start_curvature is not None:
                 nrm = np.array([-tan[1], tan[0]]) * float(self.start_curvature)
-                bc = ([(1, tan), (2, nrm)], [(2, np.zeros(2))])
+                mode = 2
 
-        def fit(x: np.ndarray, y: np.ndarray):
-            if self.start_curvature is None:
-                return CubicSpline(x, y, axis=0, bc_type=bc)
-            # The extra knot sets how far the start curvature reaches into the curve.
+        def fit(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            # The extra knot (mode 2) sets how far the start curvature reaches into the curve.
             extra = x[0] + min(0.5 * (x[1] - x[0]), START_KNOT)
-            t = np.concatenate([[x[0]] * 4, [extra], x[1:-1], [x[-1]] * 4])
-            return make_interp_spline(x, y, k=3, t=t, bc_type=bc, axis=0)
+            return _k.cubic_spline(x, y, mode, tan, nrm, extra)
 
         u = np.concatenate([[0.0], np.cumsum(chords)])
         for _ in range(max(reparam_iters, 0)):
-            cs = fit(u, pts)
-            u = np.concatenate([[0.0], np.cumsum(self._piece_lengths(cs, u))])
-        cs = fit(u, pts)
+            bx, bc = fit(u, pts)
+            u = np.concatenate([[0.0], np.cumsum(_k.gl_lengths(bx, bc, u, 4, _GL_X, _GL_W))])
+        bx, bc = fit(u, pts)
         # Arc-length parameterisation: resample every piece at equal parameter steps, take the
         # exact arc length of each sample as its parameter and interpolate again. The samples
         # include the interpolation points, so those (and the end conditions) are kept; the
         # refit is unit speed to within ~1e-4 and departs from the first fit by far less.
         us = _subdivide(u, np.maximum(4, np.ceil(np.diff(u) / resample_step)).astype(np.int64))
-        s_of_us = np.concatenate([[0.0], np.cumsum(self._piece_lengths(cs, us))])
+        s_of_us = np.concatenate([[0.0], np.cumsum(_k.gl_lengths(bx, bc, us, 4, _GL_X, _GL_W))])
         self.point_u = s_of_us[np.searchsorted(us, u)]
-        self._cs = fit(s_of_us, cs(us))
-        # Breakpoints of the final piecewise cubic (with the extra knot of the B-spline variant).
-        self.knots = np.unique(self._cs.t) if self.start_curvature is not None else s_of_us
+        # Final piecewise cubic: breakpoints (with the extra knot in mode 2) and coefficients.
+        self._x, self._c = fit(s_of_us, _k.pp_eval(bx, bc, us, 0))
+        self.knots = self._x
         u = self.knots
-        self._d1 = self._cs.derivative(1)
-        self._d2 = self._cs.derivative(2)
-        self._d3 = self._cs.derivative(3)
         # Evaluation grid: every knot, each piece cut into equal parts of about grid_step.
         # A piece is also cut finely enough that the tangent turns by at most MAX_TURN per part.
-        fr = np.linspace(0.0, 1.0, 9)
-        uu = u[:-1, None] + np.diff(u)[:, None] * fr[None, :]
-        k_est, _ = self.curvature(uu.ravel())
-        turn = np.abs(k_est).reshape(uu.shape).max(axis=1) * np.diff(u)
-        n_parts = np.maximum(np.ceil(np.diff(u) / grid_step), np.ceil(turn / MAX_TURN))
-        n_parts = np.clip(n_parts, 1, 400).astype(int)
+        du = np.diff(u)
+        k_est, _ = _k.abs_curvature_max(self._x, self._c, u, _FR9, False)
+        turn = k_est * du
+        n_parts = np.maximum(np.ceil(du / grid_step), np.ceil(turn / MAX_TURN))
+        n_parts = np.clip(n_parts, 1, 400).astype(np.int64)
         self.u_grid = _subdivide(u, n_parts)
-        ds = self._sub_lengths(self.u_grid)
+        ds = _k.gl_lengths(self._x, self._c, self.u_grid, 1, _GL_X, _GL_W)
         self.s_grid = np.concatenate([[0.0], np.cumsum(ds)])
         self.length = float(self.s_grid[-1])
-        self._dus = 1.0 / np.hypot(*self._d1(self.u_grid).T)
+        self._dus = 1.0 / np.hypot(*_k.pp_eval(self._x, self._c, self.u_grid, 1).T)
 
     # --- evaluation -------------------------------------------------------------------------
     @staticmethod
-    def _piece_lengths(cs, u: np.ndarray) -> np.ndarray:
-        # 4 sub-intervals x 5 Gauss points per piece: relative error far below 1e-9 here.
-        h = np.diff(u)[:, None] / 4.0
-        nodes = (u[:-1, None] + h * (np.arange(4)[:, None] + _GL_X[None, :]).ravel()[None, :])
-        sp = np.hypot(*cs(nodes.ravel(), 1).T).reshape(nodes.shape)
-        return (sp * np.tile(_GL_W, 4)[None, :]).sum(axis=1) * h[:, 0]
-
-    def _sub_lengths(self, ug: np.ndarray) -> np.ndarray:
-        h = np.diff(ug)[:, None]
-        nodes = ug[:-1, None] + h * _GL_X[None, :]
-        sp = np.hypot(*self._d1(nodes.ravel()).T).reshape(nodes.shape)
-        return (sp * _GL_W[None, :]).sum(axis=1) * h[:, 0]
+    def _u_array(u: np.ndarray) -> np.ndarray:
+        return np.ascontiguousarray(np.asarray(u, dtype=float).ravel())
 
     def position(self, u: np.ndarray) -> np.ndarray:
         """Points r(u) [m], shape (N, 2), for parameters ``u`` (N,)."""
-        return self._cs(np.clip(np.asarray(u, dtype=float), 0.0, self.knots[-1]))
+        u = np.asarray(u, dtype=float)
+        out = _k.pp_eval_clipped(self._x, self._c, self._u_array(u), 0)
+        return out.reshape(u.shape + (2,))
 
     def derivatives(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(r', r'', r''') at ``u``, each of shape (N, 2)."""
-        uu = np.clip(np.asarray(u, dtype=float), 0.0, self.knots[-1])
-        return self._d1(uu), self._d2(uu), self._d3(uu)
+        u = np.asarray(u, dtype=float)
+        d1, d2, d3 = _k.pp_derivs(self._x, self._c, self._u_array(u))
+        shp = u.shape + (2,)
+        return d1.reshape(shp), d2.reshape(shp), d3.reshape(shp)
 
     def heading(self, u: np.ndarray) -> np.ndarray:
         """Tangent direction [rad] at ``u``."""
-        d1 = self._d1(np.clip(np.asarray(u, dtype=float), 0.0, self.knots[-1]))
-        return np.arctan2(d1[..., 1], d1[..., 0])
+        u = np.asarray(u, dtype=float)
+        d1 = _k.pp_eval_clipped(self._x, self._c, self._u_array(u), 1)
+        return np.arctan2(d1[:, 1], d1[:, 0]).reshape(u.shape)
 
     def curvature(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Signed curvature kappa [1/m] and its arc-length derivative dkappa/ds [1/m^2] at ``u``."""
-        d1, d2, d3 = self.derivatives(u)
-        sp = np.hypot(d1[..., 0], d1[..., 1])
-        cr = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]
-        kappa = cr / sp**3
-        dcr = d1[..., 0] * d3[..., 1] - d1[..., 1] * d3[..., 0]
-        dot = d1[..., 0] * d2[..., 0] + d1[..., 1] * d2[..., 1]
-        dk_du = dcr / sp**3 - 3.0 * cr * dot / sp**5
-        return kappa, dk_du / sp
+        u = np.asarray(u, dtype=float)
+        k, dk = _k.pp_curvature(self._x, self._c, self._u_array(u))
+        return k.reshape(u.shape), dk.reshape(u.shape)
 
     def u_of_s(self, s: np.ndarray) -> np.ndarray:
         """Parameter u at arc length ``s`` [m].
@@ -280,15 +266,9 @@ class SmoothCurve:
         Cubic Hermite interpolation of u(s) on the grid, with the exact slopes du/ds = 1/|r'(u)|
         at the grid points: error O(ds^4), so the speed along the curve is 1 to ~1e-6.
         """
-        s = np.clip(np.asarray(s, dtype=float), 0.0, self.length)
-        i = np.clip(np.searchsorted(self.s_grid, s, side="right") - 1, 0, len(self.s_grid) - 2)
-        h = self.s_grid[i + 1] - self.s_grid[i]
-        x = (s - self.s_grid[i]) / h
-        u0, u1 = self.u_grid[i], self.u_grid[i + 1]
-        m0, m1 = self._dus[i] * h, self._dus[i + 1] * h
-        x2, x3 = x * x, x * x * x
-        return ((2 * x3 - 3 * x2 + 1) * u0 + (x3 - 2 * x2 + x) * m0 + (-2 * x3 + 3 * x2) * u1
-                + (x3 - x2) * m1)
+        s = np.asarray(s, dtype=float)
+        out = _k.hermite_u_of_s(self.s_grid, self.u_grid, self._dus, self.length, self._u_array(s))
+        return out.reshape(s.shape)
 
     def point_index(self, u: np.ndarray) -> np.ndarray:
         """Index k of the interpolation interval [point_u[k], point_u[k+1]] containing each ``u``."""

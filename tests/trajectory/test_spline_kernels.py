@@ -1,0 +1,59 @@
+"""Our own cubic-spline solver and evaluator against scipy's (the curves must be the same)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.interpolate import CubicSpline, make_interp_spline
+
+from anyplan.trajectory import _kernels as k
+from anyplan.trajectory.spline import START_KNOT, SmoothCurve
+
+
+def _points(seed: int, n: int) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    y = np.cumsum(rng.uniform(-1.0, 2.0, (n, 2)), axis=0)
+    x = np.concatenate([[0.0], np.cumsum(rng.uniform(0.05, 3.0, n - 1))])
+    return x, y
+
+
+@pytest.mark.parametrize("seed", range(12))
+@pytest.mark.parametrize("n", [2, 3, 4, 9])
+def test_cubic_spline_matches_scipy(seed, n):
+    x, y = _points(seed, n)
+    th = float(np.random.default_rng(seed + 100).uniform(-math.pi, math.pi))
+    tan = np.array([math.cos(th), math.sin(th)])
+    kap = float(np.random.default_rng(seed + 200).uniform(-3.0, 3.0))
+    nrm = np.array([-tan[1], tan[0]]) * kap
+    extra = x[0] + min(0.5 * (x[1] - x[0]), START_KNOT)
+    t_knots = np.concatenate([[x[0]] * 4, [extra], x[1:-1], [x[-1]] * 4])
+    refs = {
+        0: CubicSpline(x, y, axis=0, bc_type="natural"),
+        1: CubicSpline(x, y, axis=0, bc_type=((1, tan), (2, np.zeros(2)))),
+        2: make_interp_spline(x, y, k=3, t=t_knots, bc_type=([(1, tan), (2, nrm)], [(2, np.zeros(2))]),
+                              axis=0),
+    }
+    u = np.concatenate([np.linspace(x[0] - 0.5, x[-1] + 0.5, 501), x])
+    scale = 1.0 + np.abs(y).max()
+    for mode, ref in refs.items():
+        bx, bc = k.cubic_spline(x, y, mode, tan, nrm, extra)
+        assert len(bx) == len(x) + (mode == 2)
+        for nu in range(4):
+            got = k.pp_eval(bx, bc, u, nu)
+            want = ref(u, nu)
+            # the third derivative jumps at the breakpoints: compare away from them only
+            sel = np.min(np.abs(u[:, None] - bx[None, :]), axis=1) > 1e-9 if nu == 3 else slice(None)
+            np.testing.assert_allclose(got[sel], want[sel], rtol=0, atol=1e-9 * scale * 10 ** nu)
+
+
+def test_curve_queries_keep_shapes():
+    c = SmoothCurve(np.array([[0.0, 0.0], [2.0, 1.0], [4.0, -1.0]]), start_heading=0.3,
+                    start_curvature=0.5)
+    assert c.position(1.0).shape == (2,)
+    assert c.position(np.zeros((3, 4))).shape == (3, 4, 2)
+    assert c.heading(np.zeros((3, 4))).shape == (3, 4)
+    k0, dk0 = c.curvature(np.array([0.0]))
+    assert k0[0] == pytest.approx(0.5, abs=1e-9)
+    assert c.u_of_s(np.zeros((2, 5))).shape == (2, 5)
