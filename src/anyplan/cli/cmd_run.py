@@ -10,7 +10,7 @@ from anyplan.agents.base import AGENTS, make_agent
 from anyplan.simulation.simulator import SimConfig, simulate
 from anyplan.world.scenario import builtin_scenarios, load_scenario
 
-DEFAULT_PLANNER = "straight"
+DEFAULT_PLANNER = "seq-bitstar"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
