@@ -119,6 +119,8 @@ class BITStarAgent(Agent):
             "reference_duration_s": traj.duration,
             "time_lower_bound_s": traj.lower_bound_s,
             "smoothed_path": traj.path[:: max(1, len(traj.path) // 400)].tolist(),
+            # BIT*'s cost against its own solve time, [[t_s, cost_m], ...] (OMPL's progress).
+            "progress": [[float(t), float(c)] for t, c in res.history],
         })
 
     # --- control ------------------------------------------------------------------------------

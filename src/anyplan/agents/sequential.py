@@ -207,6 +207,9 @@ class SequentialBITStarAgent(Agent):
         if res.status == "waiting":
             ex["waits"] += 1
         st.virtual_obstacles.extend(v.to_dict() for v in res.virtual_obstacles)
+        if "progress" not in ex and res.history:
+            # BIT*'s cost against solve time in the first planning (OMPL's progress property).
+            ex["progress"] = [[float(a), float(b)] for a, b in res.history]
         if res.motion is None:
             return  # keep the current reference (or stay put): the next check tries again
         t_switch = t_ready

@@ -160,6 +160,7 @@ class SequentialResult:
         plan_time_s: Wall-clock time of the BIT* searches [s].
         motion_time_s: Wall-clock time spent building motions and predicting [s].
         costs: Path cost [m] of each plan.
+        history: Cost against solve time of the first BIT* search, [(t [s], cost [m]), ...].
     """
 
     status: str
@@ -172,6 +173,7 @@ class SequentialResult:
     plan_time_s: float = 0.0
     motion_time_s: float = 0.0
     costs: list[float] = field(default_factory=list)
+    history: list[tuple[float, float]] = field(default_factory=list)
 
     @property
     def collision_free(self) -> bool:
@@ -262,6 +264,7 @@ class SequentialBITStar:
         candidates: list[tuple[np.ndarray, list[Shape]]] = []
         plan_time = motion_time = 0.0
         costs: list[float] = []
+        history: list[tuple[float, float]] = []
         problem = Problem.create(self.obstacles, start, goal, self.plan_radius)
         if not problem.start_valid():
             # Hugging an obstacle: plan for the robot itself, without the planning margin.
@@ -284,6 +287,8 @@ class SequentialBITStar:
                 status = "plan_failed"
                 break
             costs.append(float(res.cost))
+            if it == 0:
+                history = list(res.history)
             t1 = time.perf_counter()
             shapes = [s.shape for s in squares]
             motion = self.motion_fn(res.path, shapes, 0.0)
@@ -295,6 +300,7 @@ class SequentialBITStar:
                                        res.path, motion, list(squares), it + 1, 0.0, hit)
             if hit is None:
                 attempt.plan_time_s, attempt.motion_time_s, attempt.costs = plan_time, motion_time, costs
+                attempt.history = history
                 return attempt
             if best is None or hit.t > best.collision.t:  # type: ignore[union-attr]
                 best = attempt
@@ -313,7 +319,7 @@ class SequentialBITStar:
             path, shapes, delay, motion = waited
             n = len(shapes)
             return SequentialResult("waiting", path, motion, squares[:n], len(costs), delay, None,
-                                    plan_time, motion_time, costs)
+                                    plan_time, motion_time, costs, history)
         if best is None:
             return SequentialResult(status if not blocked else "plan_failed", np.zeros((0, 2)), None,
                                     squares, len(costs), plan_time_s=plan_time,
@@ -321,6 +327,7 @@ class SequentialBITStar:
         best.status = "collision_predicted"
         best.iterations = len(costs)
         best.plan_time_s, best.motion_time_s, best.costs = plan_time, motion_time, costs
+        best.history = history
         return best
 
     def _virtual_obstacle(self, hit: PredictedCollision, start: np.ndarray, goal: np.ndarray,
