@@ -127,3 +127,15 @@ def test_runs_are_deterministic_for_a_seed():
 def test_bad_sim_config():
     with pytest.raises(ValueError, match="dt"):
         SimConfig(dt=0.1)
+
+
+def test_observations_announce_motions_only_when_configured():
+    d = small_scenario_dict()
+    d["dynamic_obstacles"][0]["start_time"] = 2.0
+    sc = scenario_from_dict(d)
+    for announce in (True, False):
+        agent = ObservingAgent()
+        simulate(sc, agent, seed=0, config=SimConfig(time_limit=1.0, announce_motions=announce))
+        o = agent.obs_log[0].obstacles[0]
+        assert o.v == 0.0  # waiting for its start time
+        assert (o.motion is sc.moving_obstacles[0].motion) == announce

@@ -43,11 +43,16 @@ class SimConfig:
         dt: Step and control period [s], in (0, 0.05].
         time_limit: Maximum simulated time [s]; None uses the scenario's ``time_limit``.
         stop_on_collision: End the run at the first collision.
+        announce_motions: Observations carry each visible obstacle's motion model (the paper's
+            assumption: the obstacles' motion is known). Off, agents get only the current pose
+            and twist and must extrapolate (a constant twist is then wrong at the corners of a
+            waypoint track and before a ``start_time``).
     """
 
     dt: float = 0.05
     time_limit: float | None = None
     stop_on_collision: bool = True
+    announce_motions: bool = True
 
     def __post_init__(self) -> None:
         if not 0.0 < self.dt <= 0.05:
@@ -113,15 +118,18 @@ def _jsonable(obj: Any) -> Any:
     return obj
 
 
-def observe(scenario: Scenario, t: float, robot: RobotState) -> tuple[ObstacleObservation, ...]:
-    """The moving obstacles visible at time ``t`` [s] (within the sensing range, if any)."""
+def observe(scenario: Scenario, t: float, robot: RobotState,
+            announce: bool = True) -> tuple[ObstacleObservation, ...]:
+    """The moving obstacles visible at time ``t`` [s] (within the sensing range, if any); with
+    ``announce`` each observation carries the obstacle's motion model."""
     rng_limit = scenario.robot.sensing_range
     out = []
     for o in scenario.moving_obstacles:
         x, y, th, v, w = o.motion.state(t)
         if rng_limit is not None and math.hypot(x - robot.x, y - robot.y) > rng_limit:
             continue
-        out.append(ObstacleObservation(o.name, t, x, y, th, v, w, o.radius))
+        out.append(ObstacleObservation(o.name, t, x, y, th, v, w, o.radius,
+                                       o.motion if announce else None))
     return tuple(out)
 
 
@@ -171,7 +179,7 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
             reached = True
             time_to_goal = t
             break
-        obs = Observation(t, state, observe(scenario, t, state))
+        obs = Observation(t, state, observe(scenario, t, state, cfg.announce_motions))
         cmd = agent.act(obs)
         new = step(spec, state, cmd, dt)
         t_new = (i + 1) * dt
