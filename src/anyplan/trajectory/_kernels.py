@@ -26,6 +26,8 @@ import math
 import numpy as np
 from numba import njit
 
+from anyplan.geometry._kernels import segment_clearance
+
 # Gauss-Legendre nodes/weights on [0, 1] (5 points: exact for polynomials of degree 9).
 _X, _W = np.polynomial.legendre.leggauss(5)
 GL_X = 0.5 * (_X + 1.0)
@@ -154,12 +156,26 @@ def _piece(x: np.ndarray, u: float) -> int:
 
 
 @njit(cache=True)
+def _locate(x: np.ndarray, u: float, i: int) -> int:
+    """:func:`_piece` with a guess ``i`` (the previous piece of an increasing sequence)."""
+    last = x.shape[0] - 2
+    if 0 <= i <= last and (i == 0 or u >= x[i]):
+        if i == last or u < x[i + 1]:
+            return i
+        j = i + 1
+        if u >= x[j] and (j == last or u < x[j + 1]):
+            return j
+    return _piece(x, u)
+
+
+@njit(cache=True)
 def pp_eval(x: np.ndarray, c: np.ndarray, u: np.ndarray, nu: int) -> np.ndarray:
     """Derivative ``nu`` (0-3) of the curve at ``u`` (N,); shape (N, 2)."""
     n = u.shape[0]
     out = np.empty((n, 2))
+    i = 0
     for k in range(n):
-        i = _piece(x, u[k])
+        i = _locate(x, u[k], i)
         t = u[k] - x[i]
         for d in range(2):
             c0, c1, c2, c3 = c[i, 0, d], c[i, 1, d], c[i, 2, d], c[i, 3, d]
@@ -189,9 +205,10 @@ def pp_derivs(x: np.ndarray, c: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, 
     d2 = np.empty((n, 2))
     d3 = np.empty((n, 2))
     xe = x[-1]
+    i = 0
     for k in range(n):
         uk = min(max(u[k], 0.0), xe)
-        i = _piece(x, uk)
+        i = _locate(x, uk, i)
         t = uk - x[i]
         for d in range(2):
             c1, c2, c3 = c[i, 1, d], c[i, 2, d], c[i, 3, d]
@@ -227,9 +244,10 @@ def pp_curvature(x: np.ndarray, c: np.ndarray, u: np.ndarray) -> tuple[np.ndarra
     k = np.empty(n)
     dk = np.empty(n)
     xe = x[-1]
+    i = 0
     for j in range(n):
         uj = min(max(u[j], 0.0), xe)
-        i = _piece(x, uj)
+        i = _locate(x, uj, i)
         k[j], dk[j], _, _ = _curv_at(c, i, uj - x[i])
     return k, dk
 
@@ -243,6 +261,7 @@ def abs_curvature_max(x: np.ndarray, c: np.ndarray, u: np.ndarray, fr: np.ndarra
     kk = np.empty(m)
     dd = np.empty(m)
     xe = x[-1]
+    i = 0
     for j in range(m):
         a = u[j]
         h = u[j + 1] - a
@@ -250,7 +269,7 @@ def abs_curvature_max(x: np.ndarray, c: np.ndarray, u: np.ndarray, fr: np.ndarra
         dmx = 0.0
         for f in range(fr.shape[0]):
             uj = min(max(a + h * fr[f], 0.0), xe)
-            i = _piece(x, uj)
+            i = _locate(x, uj, i)
             k, dk, _, _ = _curv_at(c, i, uj - x[i])
             km = max(km, abs(k))
             dmx = max(dmx, abs(dk))
@@ -258,9 +277,10 @@ def abs_curvature_max(x: np.ndarray, c: np.ndarray, u: np.ndarray, fr: np.ndarra
         dd[j] = dmx
     if with_ends:
         prev = 0.0
+        i = 0
         for j in range(m + 1):
             uj = min(max(u[j], 0.0), xe)
-            i = _piece(x, uj)
+            i = _locate(x, uj, i)
             k, _, _, _ = _curv_at(c, i, uj - x[i])
             k = abs(k)
             if j > 0:
@@ -275,17 +295,18 @@ def gl_lengths(x: np.ndarray, c: np.ndarray, u: np.ndarray, nsub: int, gx: np.nd
     """Arc length of each interval [u_k, u_{k+1}]: ``nsub`` equal parts x 5-point Gauss."""
     m = u.shape[0] - 1
     out = np.empty(m)
+    i = 0
     for k in range(m):
         h = (u[k + 1] - u[k]) / nsub
         acc = 0.0
         for q in range(nsub):
             for g in range(gx.shape[0]):
                 uu = u[k] + h * (q + gx[g])
-                i = _piece(x, uu)
+                i = _locate(x, uu, i)
                 t = uu - x[i]
                 ax = c[i, 1, 0] + t * (2.0 * c[i, 2, 0] + 3.0 * t * c[i, 3, 0])
                 ay = c[i, 1, 1] + t * (2.0 * c[i, 2, 1] + 3.0 * t * c[i, 3, 1])
-                acc += math.hypot(ax, ay) * gw[g]
+                acc += math.sqrt(ax * ax + ay * ay) * gw[g]
         out[k] = acc * h
     return out
 
@@ -310,3 +331,235 @@ def hermite_u_of_s(s_grid: np.ndarray, u_grid: np.ndarray, dus: np.ndarray, leng
         out[j] = ((2 * x3 - 3 * x2 + 1) * u_grid[i] + (x3 - 2 * x2 + xx) * m0
                   + (-2 * x3 + 3 * x2) * u_grid[i + 1] + (x3 - x2) * m1)
     return out
+
+
+@njit(cache=True)
+def chord_deviation(x: np.ndarray, c: np.ndarray, a_u: np.ndarray,
+                    b_u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For pieces [a_u, b_u] (within one cubic): end points (N, 2) each and the bound
+    M h^2 / 8 on the curve's distance from its chord, M = max |r''| at both ends (r'' at b_u
+    taken just inside the piece)."""
+    n = a_u.shape[0]
+    pa = np.empty((n, 2))
+    pb = np.empty((n, 2))
+    dev = np.empty(n)
+    xe = x[-1]
+    i = 0
+    for j in range(n):
+        a = min(max(a_u[j], 0.0), xe)
+        b = min(max(b_u[j], 0.0), xe)
+        bi = min(max(b_u[j] - 1e-12 * max(1.0, abs(b_u[j])), 0.0), xe)
+        i = _locate(x, a, i)
+        ia = i
+        t = a - x[i]
+        m2 = 0.0
+        for d in range(2):
+            pa[j, d] = c[i, 0, d] + t * (c[i, 1, d] + t * (c[i, 2, d] + t * c[i, 3, d]))
+        m2 = math.hypot(2.0 * c[i, 2, 0] + 6.0 * t * c[i, 3, 0], 2.0 * c[i, 2, 1] + 6.0 * t * c[i, 3, 1])
+        i = _locate(x, b, i)
+        t = b - x[i]
+        for d in range(2):
+            pb[j, d] = c[i, 0, d] + t * (c[i, 1, d] + t * (c[i, 2, d] + t * c[i, 3, d]))
+        i = _locate(x, bi, ia)
+        t = bi - x[i]
+        m2b = math.hypot(2.0 * c[i, 2, 0] + 6.0 * t * c[i, 3, 0], 2.0 * c[i, 2, 1] + 6.0 * t * c[i, 3, 1])
+        h = b_u[j] - a_u[j]
+        dev[j] = max(m2, m2b) * h * h / 8.0
+    return pa, pb, dev
+
+
+@njit(cache=True)
+def regular(x: np.ndarray, c: np.ndarray, u: np.ndarray, s: np.ndarray, min_speed: float) -> bool:
+    """The test of ``SmoothCurve.is_regular`` on the grid ``u`` (arc lengths ``s``)."""
+    n = u.shape[0]
+    xe = x[-1]
+    th_prev = 0.0
+    k_prev = 0.0
+    ok = True
+    i = 0
+    for j in range(n):
+        ip = i
+        uj = min(max(u[j], 0.0), xe)
+        i = _locate(x, uj, i)
+        k, _, th, sp = _curv_at(c, i, uj - x[i])
+        if sp < min_speed:
+            return False
+        if j > 0:
+            um = 0.5 * (u[j - 1] + u[j])
+            um = min(max(um, 0.0), xe)
+            im = _locate(x, um, ip)
+            km, _, _, spm = _curv_at(c, im, um - x[im])
+            if spm < min_speed:
+                return False
+            d = th - th_prev
+            dth = abs(math.atan2(math.sin(d), math.cos(d)))
+            kb = max(abs(k_prev), abs(k), abs(km))
+            if not dth <= 1.5 * kb * (s[j] - s[j - 1]) + 1e-6:
+                ok = False
+        th_prev = th
+        k_prev = k
+    return ok
+
+
+@njit(cache=True)
+def _hermite_one(s_grid: np.ndarray, u_grid: np.ndarray, dus: np.ndarray, length: float,
+                 s: float) -> float:
+    sj = min(max(s, 0.0), length)
+    i = np.searchsorted(s_grid, sj, side="right") - 1
+    i = min(max(i, 0), s_grid.shape[0] - 2)
+    h = s_grid[i + 1] - s_grid[i]
+    xx = (sj - s_grid[i]) / h
+    m0 = dus[i] * h
+    m1 = dus[i + 1] * h
+    x2 = xx * xx
+    x3 = x2 * xx
+    return ((2 * x3 - 3 * x2 + 1) * u_grid[i] + (x3 - 2 * x2 + xx) * m0
+            + (-2 * x3 + 3 * x2) * u_grid[i + 1] + (x3 - x2) * m1)
+
+
+@njit(cache=True)
+def speed_bound(x: np.ndarray, c: np.ndarray, s_grid: np.ndarray, u_grid: np.ndarray,
+                dus: np.ndarray, length: float, s: np.ndarray, v: np.ndarray, nsub: int) -> float:
+    """max over profile intervals of (largest chord rate |dr|/ds over ``nsub`` equal parts)
+    times the interval's larger end speed."""
+    best = 0.0
+    xe = x[-1]
+    i = 0
+    for j in range(s.shape[0] - 1):
+        h = s[j + 1] - s[j]
+        px = 0.0
+        py = 0.0
+        rmax = 0.0
+        for q in range(nsub + 1):
+            sq = s[j] + h * (q / nsub)
+            uq = _hermite_one(s_grid, u_grid, dus, length, sq)
+            uq = min(max(uq, 0.0), xe)
+            i = _locate(x, uq, i)
+            t = uq - x[i]
+            qx = c[i, 0, 0] + t * (c[i, 1, 0] + t * (c[i, 2, 0] + t * c[i, 3, 0]))
+            qy = c[i, 0, 1] + t * (c[i, 1, 1] + t * (c[i, 2, 1] + t * c[i, 3, 1]))
+            if q > 0:
+                rmax = max(rmax, math.hypot(qx - px, qy - py) / (h / nsub))
+            px = qx
+            py = qy
+        best = max(best, rmax * max(v[j], v[j + 1]))
+    return best
+
+
+@njit(cache=True)
+def curve_sample(x: np.ndarray, c: np.ndarray, s_grid: np.ndarray, u_grid: np.ndarray,
+                 dus: np.ndarray, length: float, ps: np.ndarray, pv: np.ndarray, pt: np.ndarray,
+                 tau: np.ndarray) -> np.ndarray:
+    """Reference (x, y, theta, v, omega) at profile times ``tau`` (clamped); shape (5, N)."""
+    n = tau.shape[0]
+    out = np.empty((5, n))
+    t_end = pt[-1]
+    last = pt.shape[0] - 2
+    xe = x[-1]
+    for j in range(n):
+        tj = min(max(tau[j], 0.0), t_end)
+        i = np.searchsorted(pt, tj, side="right") - 1
+        i = min(max(i, 0), last)
+        a = (pv[i + 1] ** 2 - pv[i] ** 2) / (2.0 * (ps[i + 1] - ps[i]))
+        dt = tj - pt[i]
+        vj = max(pv[i] + a * dt, 0.0)
+        sj = min(ps[i] + pv[i] * dt + 0.5 * a * dt * dt, ps[i + 1])
+        uj = _hermite_one(s_grid, u_grid, dus, length, sj)
+        uj = min(max(uj, 0.0), xe)
+        p = _piece(x, uj)
+        t = uj - x[p]
+        out[0, j] = c[p, 0, 0] + t * (c[p, 1, 0] + t * (c[p, 2, 0] + t * c[p, 3, 0]))
+        out[1, j] = c[p, 0, 1] + t * (c[p, 1, 1] + t * (c[p, 2, 1] + t * c[p, 3, 1]))
+        k, _, th, _ = _curv_at(c, p, t)
+        out[2, j] = th
+        out[3, j] = vj
+        out[4, j] = k * vj
+    return out
+
+
+@njit(cache=True)
+def certify(x: np.ndarray, c: np.ndarray, u: np.ndarray, limit: float, radius: float,
+            max_depth: int, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
+            circles: np.ndarray, bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """Certified chord test of the pieces [u_j, u_{j+1}] with up to ``max_depth`` 4-way splits.
+
+    A piece is certified when (exact chord clearance) - M h^2 / 8 >= ``limit``
+    (:func:`chord_deviation`). Returns the midpoints and certified clearances of the pieces that
+    still fail at ``max_depth`` (in order of u) and min(certified clearance) - ``radius`` over
+    the certified pieces (inf if none). Before the last level only pass/fail matters, so the
+    clearance query may stop early once it is known to be below the threshold (minus 1e-9 m,
+    far beyond rounding, so pass/fail is exactly that of the exact clearance).
+    """
+    a_u = u[:-1].copy()
+    b_u = u[1:].copy()
+    margin = np.inf
+    fail_u = np.zeros(0)
+    fail_c = np.zeros(0)
+    for depth in range(max_depth + 1):
+        n = a_u.shape[0]
+        if n == 0:
+            break
+        pa, pb, dev = chord_deviation(x, c, a_u, b_u)
+        fail = np.zeros(n, dtype=np.bool_)
+        clr = np.empty(n)
+        nf = 0
+        last = depth == max_depth
+        for j in range(n):
+            stop = -1.0 if last else limit + dev[j] - 1e-9
+            cl = segment_clearance(pa[j, 0], pa[j, 1], pb[j, 0], pb[j, 1], vx, vy, starts, pbox,
+                                   circles, bounds, stop)
+            if cl < stop:
+                fail[j] = True
+                nf += 1
+                continue
+            cj = cl - dev[j]
+            clr[j] = cj
+            if cj >= limit:
+                margin = min(margin, cj - radius)
+            else:
+                fail[j] = True
+                nf += 1
+        if nf == 0:
+            break
+        if last:
+            fail_u = np.empty(nf)
+            fail_c = np.empty(nf)
+            q = 0
+            for j in range(n):
+                if fail[j]:
+                    fail_u[q] = 0.5 * (a_u[j] + b_u[j])
+                    fail_c[q] = clr[j]
+                    q += 1
+            break
+        na = np.empty(4 * nf)
+        nb = np.empty(4 * nf)
+        q = 0
+        for j in range(n):
+            if fail[j]:
+                fa = a_u[j]
+                w = b_u[j] - fa
+                for p in range(4):
+                    na[q + p] = fa + w * (p / 4.0)
+                    nb[q + p] = fa + w * ((p + 1) / 4.0)
+                q += 4
+        a_u = na
+        b_u = nb
+    return fail_u, fail_c, margin
+
+
+@njit(cache=True)
+def worst_per_group(k: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For a non-decreasing ``k``: each distinct value and the index of the first minimum of ``v``
+    among its entries."""
+    n = k.shape[0]
+    keys = np.empty(n, dtype=np.int64)
+    idx = np.empty(n, dtype=np.int64)
+    g = -1
+    for j in range(n):
+        if g < 0 or k[j] != keys[g]:
+            g += 1
+            keys[g] = k[j]
+            idx[g] = j
+        elif v[j] < v[idx[g]]:
+            idx[g] = j
+    return keys[:g + 1], idx[:g + 1]

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from anyplan.trajectory import _kernels as _k
 from anyplan.trajectory.spline import SmoothCurve
 from anyplan.world.robot import RobotSpec
 
@@ -48,6 +49,10 @@ __all__ = ["SpeedProfile", "time_parameterize", "time_lower_bound"]
 KAPPA_INFLATION = 1.02
 #: Sub-samples per grid interval used to bound |kappa| and |kappa'|.
 SUBSAMPLES = 6
+_FR = np.linspace(0.0, 1.0, SUBSAMPLES + 1)
+# keep the right end inside the same cubic piece: kappa' jumps at the knots
+_FR[-1] = 1.0 - 1e-9
+_FR[0] = 1e-9
 
 
 @dataclass
@@ -98,17 +103,9 @@ class SpeedProfile:
 
 def _interval_bounds(curve: SmoothCurve, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Bounds on |kappa| and |kappa'| over each interval [u_i, u_{i+1}] (never across a knot)."""
-    fr = np.linspace(0.0, 1.0, SUBSAMPLES + 1)
-    # keep the right end inside the same cubic piece: kappa' jumps at the knots
-    fr[-1] = 1.0 - 1e-9
-    fr[0] = 1e-9
-    uu = u[:-1, None] + np.diff(u)[:, None] * fr[None, :]
-    k, dk = curve.curvature(uu.ravel())
-    k = np.abs(k).reshape(uu.shape).max(axis=1)
-    dk = np.abs(dk).reshape(uu.shape).max(axis=1)
-    # Endpoint values, exactly at the grid points, also count (kappa is continuous).
-    ke, _ = curve.curvature(u)
-    k = np.maximum(k, np.maximum(np.abs(ke[:-1]), np.abs(ke[1:])))
+    # Sub-samples at fractions fr of each interval; endpoint values, exactly at the grid points,
+    # also count for |kappa| (kappa is continuous).
+    k, dk = _k.abs_curvature_max(curve._x, curve._c, np.ascontiguousarray(u, dtype=float), _FR, True)
     return k * KAPPA_INFLATION + 1e-9, dk * KAPPA_INFLATION + 1e-9
 
 

@@ -20,6 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from anyplan.trajectory import _kernels as _k
 from anyplan.trajectory.profile import SpeedProfile
 from anyplan.trajectory.spline import SmoothCurve
 from anyplan.trajectory.turn import RotationProfile
@@ -58,22 +59,19 @@ class CurveSegment(Segment):
         self.t0 = float(t0)
         self.t1 = self.t0 + profile.duration
         self.length = curve.length
-        # |d position/dt| = |r'(u(s))| u'(s) v: measure the first factor (1 to ~1e-6) finely.
-        s = profile.s
-        fr = np.linspace(0.0, 1.0, 9)
-        ss = (s[:-1, None] + np.diff(s)[:, None] * fr[None, :]).ravel()
-        pp = curve.position(curve.u_of_s(ss)).reshape(len(s) - 1, len(fr), 2)
-        rate = np.hypot(*np.diff(pp, axis=1).transpose(2, 0, 1)) / (np.diff(s)[:, None] / 8.0)
-        vmax = np.maximum(profile.v[:-1], profile.v[1:])
-        self.max_speed = float(np.max(rate.max(axis=1) * vmax)) * 1.01 if len(vmax) else 0.0
+        # |d position/dt| = |r'(u(s))| u'(s) v: measure the first factor (1 to ~1e-6) finely,
+        # as chord lengths over 8 equal parts of each profile interval.
+        c = curve
+        self._args = (c._x, c._c, c.s_grid, c.u_grid, c._dus, c.length,
+                      np.ascontiguousarray(profile.s, dtype=float),
+                      np.ascontiguousarray(profile.v, dtype=float),
+                      np.ascontiguousarray(profile.t, dtype=float))
+        self.max_speed = (_k.speed_bound(*self._args[:8], 8) * 1.01) if len(profile.s) > 1 else 0.0
 
     def sample(self, t: np.ndarray) -> Sample:
-        s, v, _ = self.profile.at_time(np.asarray(t, dtype=float) - self.t0)
-        u = self.curve.u_of_s(s)
-        p = self.curve.position(u)
-        th = self.curve.heading(u)
-        kappa, _ = self.curve.curvature(u)
-        return p[:, 0], p[:, 1], th, v, kappa * v
+        t = np.asarray(t, dtype=float)
+        out = _k.curve_sample(*self._args, np.ascontiguousarray(t.ravel()) - self.t0)
+        return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
 
     def path_points(self, step: float) -> np.ndarray:
         return self.curve.samples(step)
@@ -219,6 +217,17 @@ class Trajectory:
         """
         t = np.asarray(t, dtype=float)
         flat = t.ravel()
+        if len(self.segments) == 1 or flat.size == 1:
+            # one segment serves every time (the common case: a control step or one query)
+            k = 0 if len(self.segments) == 1 else min(
+                max(int(np.searchsorted(self._starts, flat[0], side="right")) - 1, 0),
+                len(self.segments) - 1)
+            vals = [np.asarray(v, dtype=float).reshape(flat.shape) for v in self.segments[k].sample(flat)]
+            after = flat >= self.t_end
+            if after.any():
+                vals[3] = np.where(after, 0.0, vals[3])
+                vals[4] = np.where(after, 0.0, vals[4])
+            return tuple(o.reshape(t.shape) for o in vals)  # type: ignore[return-value]
         out = [np.empty(flat.shape) for _ in range(5)]
         idx = np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0, len(self.segments) - 1)
         for k in np.unique(idx):
