@@ -217,27 +217,25 @@ class Trajectory:
         """
         t = np.asarray(t, dtype=float)
         flat = t.ravel()
-        if len(self.segments) == 1 or flat.size == 1:
-            # one segment serves every time (the common case: a control step or one query)
-            k = 0 if len(self.segments) == 1 else min(
-                max(int(np.searchsorted(self._starts, flat[0], side="right")) - 1, 0),
-                len(self.segments) - 1)
-            vals = [np.asarray(v, dtype=float).reshape(flat.shape) for v in self.segments[k].sample(flat)]
-            after = flat >= self.t_end
-            if after.any():
-                vals[3] = np.where(after, 0.0, vals[3])
-                vals[4] = np.where(after, 0.0, vals[4])
-            return tuple(o.reshape(t.shape) for o in vals)  # type: ignore[return-value]
-        out = [np.empty(flat.shape) for _ in range(5)]
-        idx = np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0, len(self.segments) - 1)
-        for k in np.unique(idx):
-            m = idx == k
-            vals = self.segments[k].sample(flat[m])
-            for o, val in zip(out, vals, strict=True):
-                o[m] = val
+        nseg = len(self.segments)
+        idx = (np.zeros(flat.shape, dtype=np.int64) if nseg == 1 else
+               np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0, nseg - 1))
+        if flat.size and (nseg == 1 or idx.min() == idx.max()):
+            # one segment serves every time (the common case: a control step or one query);
+            # copies, as in the general case, so that no two outputs share memory
+            out = [np.array(v, dtype=float).reshape(flat.shape)
+                   for v in self.segments[int(idx[0])].sample(flat)]
+        else:
+            out = [np.empty(flat.shape) for _ in range(5)]
+            for k in np.unique(idx):
+                m = idx == k
+                vals = self.segments[k].sample(flat[m])
+                for o, val in zip(out, vals, strict=True):
+                    o[m] = val
         after = flat >= self.t_end
-        out[3][after] = 0.0
-        out[4][after] = 0.0
+        if after.any():
+            out[3] = np.where(after, 0.0, out[3])
+            out[4] = np.where(after, 0.0, out[4])
         return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
 
     def positions(self, t: np.ndarray | float) -> np.ndarray:
