@@ -219,22 +219,23 @@ def pp_derivs(x: np.ndarray, c: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, 
 
 
 @njit(cache=True)
-def _curv_at(c: np.ndarray, i: int, t: float) -> tuple[float, float, float, float]:
-    """(kappa, dkappa/ds, heading, speed) on piece i at offset t."""
+def _curv_at(c: np.ndarray, i: int, t: float) -> tuple[float, float, float, float, float]:
+    """(kappa, dkappa/ds, speed |r'|, r'_x, r'_y) on piece i at offset t."""
     ax = c[i, 1, 0] + t * (2.0 * c[i, 2, 0] + 3.0 * t * c[i, 3, 0])
     ay = c[i, 1, 1] + t * (2.0 * c[i, 2, 1] + 3.0 * t * c[i, 3, 1])
     bx = 2.0 * c[i, 2, 0] + 6.0 * t * c[i, 3, 0]
     by = 2.0 * c[i, 2, 1] + 6.0 * t * c[i, 3, 1]
     gx = 6.0 * c[i, 3, 0]
     gy = 6.0 * c[i, 3, 1]
-    sp = math.hypot(ax, ay)
+    sp2 = ax * ax + ay * ay
+    sp = math.sqrt(sp2)
+    sp3 = sp2 * sp
     cr = ax * by - ay * bx
-    sp3 = sp ** 3
     kappa = cr / sp3
     dcr = ax * gy - ay * gx
     dot = ax * bx + ay * by
-    dk_du = dcr / sp3 - 3.0 * cr * dot / sp ** 5
-    return kappa, dk_du / sp, math.atan2(ay, ax), sp
+    dk_du = dcr / sp3 - 3.0 * cr * dot / (sp3 * sp2)
+    return kappa, dk_du / sp, sp, ax, ay
 
 
 @njit(cache=True)
@@ -248,7 +249,7 @@ def pp_curvature(x: np.ndarray, c: np.ndarray, u: np.ndarray) -> tuple[np.ndarra
     for j in range(n):
         uj = min(max(u[j], 0.0), xe)
         i = _locate(x, uj, i)
-        k[j], dk[j], _, _ = _curv_at(c, i, uj - x[i])
+        k[j], dk[j], _, _, _ = _curv_at(c, i, uj - x[i])
     return k, dk
 
 
@@ -270,7 +271,7 @@ def abs_curvature_max(x: np.ndarray, c: np.ndarray, u: np.ndarray, fr: np.ndarra
         for f in range(fr.shape[0]):
             uj = min(max(a + h * fr[f], 0.0), xe)
             i = _locate(x, uj, i)
-            k, dk, _, _ = _curv_at(c, i, uj - x[i])
+            k, dk, _, _, _ = _curv_at(c, i, uj - x[i])
             km = max(km, abs(k))
             dmx = max(dmx, abs(dk))
         kk[j] = km
@@ -281,7 +282,7 @@ def abs_curvature_max(x: np.ndarray, c: np.ndarray, u: np.ndarray, fr: np.ndarra
         for j in range(m + 1):
             uj = min(max(u[j], 0.0), xe)
             i = _locate(x, uj, i)
-            k, _, _, _ = _curv_at(c, i, uj - x[i])
+            k, _, _, _, _ = _curv_at(c, i, uj - x[i])
             k = abs(k)
             if j > 0:
                 kk[j - 1] = max(kk[j - 1], max(prev, k))
@@ -317,19 +318,25 @@ def hermite_u_of_s(s_grid: np.ndarray, u_grid: np.ndarray, dus: np.ndarray, leng
     """Cubic Hermite interpolation of u(s) on the grid with slopes ``dus`` (s clipped)."""
     n = s.shape[0]
     out = np.empty(n)
-    last = s_grid.shape[0] - 2
+    ih = 0
     for j in range(n):
-        sj = min(max(s[j], 0.0), length)
-        i = np.searchsorted(s_grid, sj, side="right") - 1
-        i = min(max(i, 0), last)
-        h = s_grid[i + 1] - s_grid[i]
-        xx = (sj - s_grid[i]) / h
-        m0 = dus[i] * h
-        m1 = dus[i + 1] * h
-        x2 = xx * xx
-        x3 = x2 * xx
-        out[j] = ((2 * x3 - 3 * x2 + 1) * u_grid[i] + (x3 - 2 * x2 + xx) * m0
-                  + (-2 * x3 + 3 * x2) * u_grid[i + 1] + (x3 - x2) * m1)
+        out[j], ih = _hermite_one(s_grid, u_grid, dus, length, s[j], ih)
+    return out
+
+
+@njit(cache=True)
+def subdivide(u: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Cut each interval [u[k], u[k+1]] into n[k] equal parts; all breakpoints, in order."""
+    out = np.empty(n.sum() + 1)
+    q = 0
+    for k in range(n.shape[0]):
+        a = u[k]
+        w = u[k + 1] - a
+        nk = n[k]
+        for j in range(nk):
+            out[q] = a + w * j / nk
+            q += 1
+    out[q] = u[-1]
     return out
 
 
@@ -381,14 +388,15 @@ def regular(x: np.ndarray, c: np.ndarray, u: np.ndarray, s: np.ndarray, min_spee
         ip = i
         uj = min(max(u[j], 0.0), xe)
         i = _locate(x, uj, i)
-        k, _, th, sp = _curv_at(c, i, uj - x[i])
+        k, _, sp, ax, ay = _curv_at(c, i, uj - x[i])
+        th = math.atan2(ay, ax)
         if sp < min_speed:
             return False
         if j > 0:
             um = 0.5 * (u[j - 1] + u[j])
             um = min(max(um, 0.0), xe)
             im = _locate(x, um, ip)
-            km, _, _, spm = _curv_at(c, im, um - x[im])
+            km, _, spm, _, _ = _curv_at(c, im, um - x[im])
             if spm < min_speed:
                 return False
             d = th - th_prev
@@ -403,10 +411,10 @@ def regular(x: np.ndarray, c: np.ndarray, u: np.ndarray, s: np.ndarray, min_spee
 
 @njit(cache=True)
 def _hermite_one(s_grid: np.ndarray, u_grid: np.ndarray, dus: np.ndarray, length: float,
-                 s: float) -> float:
+                 s: float, hint: int) -> tuple[float, int]:
+    """u(s) as in :func:`hermite_u_of_s` and the grid interval used (``hint``: a guess)."""
     sj = min(max(s, 0.0), length)
-    i = np.searchsorted(s_grid, sj, side="right") - 1
-    i = min(max(i, 0), s_grid.shape[0] - 2)
+    i = _locate(s_grid, sj, hint)
     h = s_grid[i + 1] - s_grid[i]
     xx = (sj - s_grid[i]) / h
     m0 = dus[i] * h
@@ -414,7 +422,7 @@ def _hermite_one(s_grid: np.ndarray, u_grid: np.ndarray, dus: np.ndarray, length
     x2 = xx * xx
     x3 = x2 * xx
     return ((2 * x3 - 3 * x2 + 1) * u_grid[i] + (x3 - 2 * x2 + xx) * m0
-            + (-2 * x3 + 3 * x2) * u_grid[i + 1] + (x3 - x2) * m1)
+            + (-2 * x3 + 3 * x2) * u_grid[i + 1] + (x3 - x2) * m1), i
 
 
 @njit(cache=True)
@@ -425,6 +433,7 @@ def speed_bound(x: np.ndarray, c: np.ndarray, s_grid: np.ndarray, u_grid: np.nda
     best = 0.0
     xe = x[-1]
     i = 0
+    ih = 0
     for j in range(s.shape[0] - 1):
         h = s[j + 1] - s[j]
         px = 0.0
@@ -432,7 +441,7 @@ def speed_bound(x: np.ndarray, c: np.ndarray, s_grid: np.ndarray, u_grid: np.nda
         rmax = 0.0
         for q in range(nsub + 1):
             sq = s[j] + h * (q / nsub)
-            uq = _hermite_one(s_grid, u_grid, dus, length, sq)
+            uq, ih = _hermite_one(s_grid, u_grid, dus, length, sq, ih)
             uq = min(max(uq, 0.0), xe)
             i = _locate(x, uq, i)
             t = uq - x[i]
@@ -464,14 +473,14 @@ def curve_sample(x: np.ndarray, c: np.ndarray, s_grid: np.ndarray, u_grid: np.nd
         dt = tj - pt[i]
         vj = max(pv[i] + a * dt, 0.0)
         sj = min(ps[i] + pv[i] * dt + 0.5 * a * dt * dt, ps[i + 1])
-        uj = _hermite_one(s_grid, u_grid, dus, length, sj)
+        uj, _ = _hermite_one(s_grid, u_grid, dus, length, sj, 0)
         uj = min(max(uj, 0.0), xe)
         p = _piece(x, uj)
         t = uj - x[p]
         out[0, j] = c[p, 0, 0] + t * (c[p, 1, 0] + t * (c[p, 2, 0] + t * c[p, 3, 0]))
         out[1, j] = c[p, 0, 1] + t * (c[p, 1, 1] + t * (c[p, 2, 1] + t * c[p, 3, 1]))
-        k, _, th, _ = _curv_at(c, p, t)
-        out[2, j] = th
+        k, _, _, ax, ay = _curv_at(c, p, t)
+        out[2, j] = math.atan2(ay, ax)
         out[3, j] = vj
         out[4, j] = k * vj
     return out
@@ -563,3 +572,64 @@ def worst_per_group(k: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarra
         elif v[j] < v[idx[g]]:
             idx[g] = j
     return keys[:g + 1], idx[:g + 1]
+
+
+@njit(cache=True)
+def _cumsum0(a: np.ndarray) -> np.ndarray:
+    out = np.empty(a.shape[0] + 1)
+    out[0] = 0.0
+    acc = 0.0
+    for j in range(a.shape[0]):
+        acc += a[j]
+        out[j + 1] = acc
+    return out
+
+
+@njit(cache=True)
+def _fit(x: np.ndarray, y: np.ndarray, mode: int, tan: np.ndarray, nrm: np.ndarray,
+         start_knot: float) -> tuple[np.ndarray, np.ndarray]:
+    extra = x[0] + min(0.5 * (x[1] - x[0]), start_knot)
+    return cubic_spline(x, y, mode, tan, nrm, extra)
+
+
+@njit(cache=True)
+def build_curve(pts: np.ndarray, mode: int, tan: np.ndarray, nrm: np.ndarray, start_knot: float,
+                reparam_iters: int, resample_step: float, grid_step: float, max_turn: float,
+                fr: np.ndarray, gx: np.ndarray, gw: np.ndarray):  # noqa: ANN201
+    """The construction of ``SmoothCurve`` (see its docstring): returns breakpoints, coefficients,
+    point_u, u_grid, s_grid and du/ds on the grid."""
+    n = pts.shape[0]
+    chords = np.empty(n - 1)
+    for j in range(n - 1):
+        chords[j] = math.hypot(pts[j + 1, 0] - pts[j, 0], pts[j + 1, 1] - pts[j, 1])
+    u = _cumsum0(chords)
+    for _ in range(max(reparam_iters, 0)):
+        bx, bc = _fit(u, pts, mode, tan, nrm, start_knot)
+        u = _cumsum0(gl_lengths(bx, bc, u, 4, gx, gw))
+    bx, bc = _fit(u, pts, mode, tan, nrm, start_knot)
+    n_us = np.empty(n - 1, dtype=np.int64)
+    for j in range(n - 1):
+        n_us[j] = max(4, int(math.ceil((u[j + 1] - u[j]) / resample_step)))
+    us = subdivide(u, n_us)
+    s_of_us = _cumsum0(gl_lengths(bx, bc, us, 4, gx, gw))
+    point_u = np.empty(n)
+    ii = np.searchsorted(us, u)
+    for j in range(n):
+        point_u[j] = s_of_us[ii[j]]
+    x, c = _fit(s_of_us, pp_eval(bx, bc, us, 0), mode, tan, nrm, start_knot)
+    k_est, _ = abs_curvature_max(x, c, x, fr, False)
+    m = x.shape[0] - 1
+    n_parts = np.empty(m, dtype=np.int64)
+    for j in range(m):
+        du = x[j + 1] - x[j]
+        p = max(math.ceil(du / grid_step), math.ceil(k_est[j] * du / max_turn))
+        if not p >= 1.0:  # also NaN
+            p = 1.0 if p < 1.0 else 400.0
+        n_parts[j] = int(min(p, 400.0))
+    u_grid = subdivide(x, n_parts)
+    s_grid = _cumsum0(gl_lengths(x, c, u_grid, 1, gx, gw))
+    d1 = pp_eval(x, c, u_grid, 1)
+    dus = np.empty(u_grid.shape[0])
+    for j in range(u_grid.shape[0]):
+        dus[j] = 1.0 / math.hypot(d1[j, 0], d1[j, 1])
+    return x, c, point_u, u_grid, s_grid, dus

@@ -70,9 +70,7 @@ MAX_TURN = 0.05
 
 def _subdivide(u: np.ndarray, n: np.ndarray) -> np.ndarray:
     """Cut each interval [u[k], u[k+1]] into n[k] equal parts; all breakpoints, in order."""
-    k = np.repeat(np.arange(len(n)), n)
-    j = np.arange(len(k)) - np.repeat(np.cumsum(n) - n, n)
-    return np.concatenate([u[k] + (u[k + 1] - u[k]) * j / n[k], u[-1:]])
+    return _k.subdivide(np.ascontiguousarray(u, dtype=float), np.ascontiguousarray(n, dtype=np.int64))
 
 
 def clean_path(path: np.ndarray, tol: float = 1e-9, collinear_tol: float = 1e-9) -> np.ndarray:
@@ -196,39 +194,24 @@ class SmoothCurve:
                 nrm = np.array([-tan[1], tan[0]]) * float(self.start_curvature)
                 mode = 2
 
-        def fit(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            # The extra knot (mode 2) sets how far the start curvature reaches into the curve.
-            extra = x[0] + min(0.5 * (x[1] - x[0]), START_KNOT)
-            return _k.cubic_spline(x, y, mode, tan, nrm, extra)
-
-        u = np.concatenate([[0.0], np.cumsum(chords)])
-        for _ in range(max(reparam_iters, 0)):
-            bx, bc = fit(u, pts)
-            u = np.concatenate([[0.0], np.cumsum(_k.gl_lengths(bx, bc, u, 4, _GL_X, _GL_W))])
-        bx, bc = fit(u, pts)
-        # Arc-length parameterisation: resample every piece at equal parameter steps, take the
-        # exact arc length of each sample as its parameter and interpolate again. The samples
-        # include the interpolation points, so those (and the end conditions) are kept; the
-        # refit is unit speed to within ~1e-4 and departs from the first fit by far less.
-        us = _subdivide(u, np.maximum(4, np.ceil(np.diff(u) / resample_step)).astype(np.int64))
-        s_of_us = np.concatenate([[0.0], np.cumsum(_k.gl_lengths(bx, bc, us, 4, _GL_X, _GL_W))])
-        self.point_u = s_of_us[np.searchsorted(us, u)]
-        # Final piecewise cubic: breakpoints (with the extra knot in mode 2) and coefficients.
-        self._x, self._c = fit(s_of_us, _k.pp_eval(bx, bc, us, 0))
+        # One compiled pass (anyplan.trajectory._kernels.build_curve):
+        # 1. knots u = chord lengths, then ``reparam_iters`` times the arc lengths of the fit;
+        # 2. arc-length refit: every piece resampled at equal parameter steps of at most
+        #    ``resample_step`` (at least 4 per piece), each sample's exact arc length (4 x 5-point
+        #    Gauss-Legendre per step) becomes its parameter, and the spline is fitted through
+        #    the samples (they include the interpolation points, so those and the end conditions
+        #    are kept; the refit is unit speed to within ~1e-4); with a start curvature an extra
+        #    knot min(half the first interval, START_KNOT) in sets how far it reaches;
+        # 3. evaluation grid: every knot, each piece cut into equal parts of about grid_step, and
+        #    finely enough that the tangent turns by at most MAX_TURN per part (|kappa| sampled at
+        #    9 points per piece), at most 400 parts;
+        # 4. exact arc length at the grid (5-point Gauss per part) and du/ds = 1 / |r'| there.
+        (self._x, self._c, self.point_u, self.u_grid, self.s_grid,
+         self._dus) = _k.build_curve(pts, mode, tan, nrm, START_KNOT, int(reparam_iters),
+                                     float(resample_step), float(grid_step), MAX_TURN, _FR9,
+                                     _GL_X, _GL_W)
         self.knots = self._x
-        u = self.knots
-        # Evaluation grid: every knot, each piece cut into equal parts of about grid_step.
-        # A piece is also cut finely enough that the tangent turns by at most MAX_TURN per part.
-        du = np.diff(u)
-        k_est, _ = _k.abs_curvature_max(self._x, self._c, u, _FR9, False)
-        turn = k_est * du
-        n_parts = np.maximum(np.ceil(du / grid_step), np.ceil(turn / MAX_TURN))
-        n_parts = np.clip(n_parts, 1, 400).astype(np.int64)
-        self.u_grid = _subdivide(u, n_parts)
-        ds = _k.gl_lengths(self._x, self._c, self.u_grid, 1, _GL_X, _GL_W)
-        self.s_grid = np.concatenate([[0.0], np.cumsum(ds)])
         self.length = float(self.s_grid[-1])
-        self._dus = 1.0 / np.hypot(*_k.pp_eval(self._x, self._c, self.u_grid, 1).T)
 
     # --- evaluation -------------------------------------------------------------------------
     @staticmethod
