@@ -80,6 +80,7 @@ def warm_up() -> float:
     obs = ObstacleSet([Circle((2.0, 2.0), 0.5)], bounds=(0.0, 0.0, 4.0, 4.0))
     p = BITStar(Problem.create(obs, (0.5, 0.5), (3.5, 3.5), 0.1), rng=0, samples_per_batch=30)
     p.solve(batches(2))  # iterate, start_batch, build_grid, compact (prune), sampling
+    p.add_obstacles([Circle((3.0, 1.0), 0.2)])  # blocked_edges (Sequential BIT* uses it)
     dt = time.perf_counter() - t0
     logger.debug("BIT* kernels ready in %.3f s", dt)
     return dt
