@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 from scipy.interpolate import CubicSpline, make_interp_spline
 
+from anyplan.geometry import Circle, ObstacleSet
 from anyplan.trajectory import _kernels as k
-from anyplan.trajectory.spline import START_KNOT, SmoothCurve
+from anyplan.trajectory.spline import START_KNOT, SmoothCurve, clean_path, shortcut_path
 
 
 def _points(seed: int, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -57,3 +58,30 @@ def test_curve_queries_keep_shapes():
     k0, dk0 = c.curvature(np.array([0.0]))
     assert k0[0] == pytest.approx(0.5, abs=1e-9)
     assert c.u_of_s(np.zeros((2, 5))).shape == (2, 5)
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_shortcut_takes_the_farthest_free_vertex(seed):
+    # Greedy farthest-in-sight: each kept vertex jumps to the farthest later vertex whose straight
+    # segment keeps the clearance (or to the next vertex if none does), checked exhaustively.
+    rng = np.random.default_rng(seed)
+    shapes = [Circle(rng.uniform(1.0, 9.0, 2), float(rng.uniform(0.2, 0.8))) for _ in range(6)]
+    obs = ObstacleSet(shapes, bounds=(0.0, 0.0, 10.0, 10.0))
+    path = np.column_stack([np.linspace(0.5, 9.5, 25), 5.0 + np.cumsum(rng.normal(0.0, 0.3, 25))])
+    path[:, 1] = np.clip(path[:, 1], 0.5, 9.5)
+    r = 0.2
+    out = shortcut_path(path, obs, r)
+    idx = [int(np.flatnonzero(np.all(path == q, axis=1))[0]) for q in out]
+    assert idx[0] == 0 and idx[-1] == len(path) - 1 and idx == sorted(idx)
+    for i, j in zip(idx[:-1], idx[1:], strict=True):
+        free = [k for k in range(i + 2, len(path)) if obs.segment_free(path[i], path[k], r)]
+        assert j == (max(free) if free else i + 1)
+
+
+def test_clean_path_keeps_turns_and_last_point():
+    p = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 1.0], [2.0, 1.0 + 1e-12]])
+    out = clean_path(p)
+    np.testing.assert_array_equal(out, [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0 + 1e-12]])
+    np.testing.assert_array_equal(clean_path(np.zeros((3, 2))), [[0.0, 0.0]])
+    with pytest.raises(ValueError, match="at least one point"):
+        clean_path(np.zeros((0, 2)))

@@ -85,28 +85,13 @@ def clean_path(path: np.ndarray, tol: float = 1e-9, collinear_tol: float = 1e-9)
     Returns:
         The cleaned points (M, 2), first and last kept.
     """
-    p = np.asarray(path, dtype=float).reshape(-1, 2)
+    p = np.ascontiguousarray(np.asarray(path, dtype=float).reshape(-1, 2))
     if len(p) == 0:
         raise ValueError("path must contain at least one point")
-    keep = [p[0]]
-    for q in p[1:]:
-        if math.hypot(q[0] - keep[-1][0], q[1] - keep[-1][1]) > tol:
-            keep.append(q)
-    if len(keep) > 1 and math.hypot(*(p[-1] - keep[-1])) > 0.0:
-        keep[-1] = p[-1]
-    out = [keep[0]]
-    for i in range(1, len(keep) - 1):
-        a, b, c = out[-1], keep[i], keep[i + 1]
-        ab, ac = b - a, c - a
-        lac = math.hypot(*ac)
-        cross = abs(ab[0] * ac[1] - ab[1] * ac[0]) / max(lac, 1e-300)
-        t = float(ab @ ac) / max(lac * lac, 1e-300)
-        if cross < collinear_tol and 0.0 < t < 1.0:
-            continue
-        out.append(b)
-    if len(keep) > 1:
-        out.append(keep[-1])
-    return np.array(out)
+    # Compiled loop: drop points within tol of the last kept one (the last input point always
+    # replaces the last kept one), then interior points off the chord of their kept predecessor
+    # and next point by less than collinear_tol and strictly between them.
+    return _k.clean_points(p, float(tol), float(collinear_tol))
 
 
 def shortcut_path(path: np.ndarray, obstacles: ObstacleSet, radius: float) -> np.ndarray:
@@ -130,18 +115,7 @@ def shortcut_path(path: np.ndarray, obstacles: ObstacleSet, radius: float) -> np
     p = np.asarray(path, dtype=float).reshape(-1, 2)
     if len(p) <= 2:
         return p.copy()
-    keep = [0]
-    i, n = 0, len(p)
-    limit = radius - COLLISION_EPS
-    while i < n - 1:
-        js = np.arange(i + 2, n)
-        nxt = i + 1
-        if len(js):
-            ok = obstacles.segments_clearance(np.repeat(p[i:i + 1], len(js), axis=0), p[js]) >= limit
-            if np.any(ok):
-                nxt = int(js[np.nonzero(ok)[0][-1]])
-        keep.append(nxt)
-        i = nxt
+    keep = _k.shortcut_indices(np.ascontiguousarray(p), radius - COLLISION_EPS, *obstacles.kernel_args)
     return p[keep]
 
 
