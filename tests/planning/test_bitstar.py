@@ -138,6 +138,16 @@ def test_infeasible_problem_times_out_without_a_path():
     assert res.path.shape == (0, 2) and res.cost == math.inf and res.first_solution_time_s is None
 
 
+def test_infeasible_problem_returns_at_its_time_budget():
+    """With a time budget the search stops (it neither hangs nor claims a solution)."""
+    wall = ObstacleSet([box(4.0, 0.0, 5.0, 10.0)], bounds=(0.0, 0.0, 10.0, 10.0))
+    planner = BITStar(Problem.create(wall, (1.0, 5.0), (8.0, 5.0), 0.2), rng=0)
+    assert planner.solve(0.05) is PlannerStatus.TIMEOUT
+    res = planner.result()
+    assert 0.05 <= res.solve_time_s < 5.0  # generous: only catches a search that never stops
+    assert res.path.shape == (0, 2) and res.history == []
+
+
 def test_start_or_goal_in_collision_gives_a_clear_status():
     obs = peers_obstacles()
     s = BITStar(Problem.create(obs, (4.0, 3.0), (14.0, 10.0), 0.2), rng=0)
