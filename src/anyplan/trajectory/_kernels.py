@@ -694,3 +694,58 @@ def shortcut_indices(p: np.ndarray, limit: float, vx: np.ndarray, vy: np.ndarray
         nk += 1
         i = nxt
     return keep[:nk].copy()
+
+
+@njit(cache=True)
+def rotation_eval(tau: np.ndarray, theta0: float, omega0: float, durations: np.ndarray,
+                  alphas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(heading, turn rate) of constant angular-acceleration phases at times ``tau`` (the last
+    phase started by tau applies, its elapsed time clamped to its duration)."""
+    n = tau.shape[0]
+    th = np.empty(n)
+    w = np.empty(n)
+    for j in range(n):
+        tj = tau[j]
+        thj = theta0
+        wj = omega0
+        t0 = 0.0
+        th0 = theta0
+        w0 = omega0
+        for k in range(durations.shape[0]):
+            d = durations[k]
+            a = alphas[k]
+            if tj >= t0:
+                dt = min(max(tj - t0, 0.0), d)
+                thj = th0 + w0 * dt + 0.5 * a * dt * dt
+                wj = w0 + a * dt
+            th0 += w0 * d + 0.5 * a * d * d
+            w0 += a * d
+            t0 += d
+        th[j] = thj
+        w[j] = wj
+    return th, w
+
+
+@njit(cache=True)
+def brake_eval(tau: np.ndarray, t_end: float, v0: float, w0: float, theta0: float, a_max: float,
+               alpha_max: float, grid: np.ndarray, gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
+    """(x, y, theta, v, omega) of braking at a_max and alpha_max, at ``tau`` clamped to
+    [0, t_end]; the position is interpolated linearly in the tabulated (grid, gx, gy)."""
+    n = tau.shape[0]
+    out = np.empty((5, n))
+    tv = abs(v0) / a_max
+    tw = abs(w0) / alpha_max
+    sv = math.copysign(a_max, v0)
+    sw = math.copysign(alpha_max, w0)
+    tt = np.empty(n)
+    for j in range(n):
+        t = min(max(tau[j], 0.0), t_end)
+        tt[j] = t
+        cv = min(t, tv)
+        cw = min(t, tw)
+        out[2, j] = theta0 + w0 * cw - 0.5 * sw * cw * cw
+        out[3, j] = v0 - sv * cv
+        out[4, j] = w0 - sw * cw
+    out[0] = np.interp(tt, grid, gx)
+    out[1] = np.interp(tt, grid, gy)
+    return out

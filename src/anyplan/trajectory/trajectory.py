@@ -136,9 +136,10 @@ class BrakeSegment(Segment):
         return z, z, th, v, w
 
     def sample(self, t: np.ndarray) -> Sample:
-        tau = np.clip(np.asarray(t, dtype=float) - self.t0, 0.0, self.t1 - self.t0)
-        _, _, th, v, w = self._twist(tau)
-        return np.interp(tau, self._tau, self._x), np.interp(tau, self._tau, self._y), th, v, w
+        t = np.asarray(t, dtype=float)
+        out = _k.brake_eval(np.ascontiguousarray(t.ravel()) - self.t0, self.t1 - self.t0, self.v0,
+                            self.w0, self.theta0, self.a, self.al, self._tau, self._x, self._y)
+        return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
 
     def path_points(self, step: float) -> np.ndarray:
         return np.column_stack([self._x, self._y])

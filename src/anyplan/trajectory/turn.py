@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from anyplan.trajectory import _kernels as _k
+
 __all__ = ["RotationProfile", "rotation_profile"]
 
 
@@ -41,17 +43,12 @@ class RotationProfile:
     def at_time(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(heading [rad], turn rate [rad/s]) at times ``tau`` [s] since the start (clamped)."""
         tau = np.asarray(tau, dtype=float)
-        th = np.full(tau.shape, self.theta0)
-        w = np.full(tau.shape, self.omega0)
-        t0, th0, w0 = 0.0, self.theta0, self.omega0
-        for d, a in zip(self.durations, self.alphas, strict=True):
-            dt = np.clip(tau - t0, 0.0, d)
-            th = np.where(tau >= t0, th0 + w0 * dt + 0.5 * a * dt * dt, th)
-            w = np.where(tau >= t0, w0 + a * dt, w)
-            th0 += w0 * d + 0.5 * a * d * d
-            w0 += a * d
-            t0 += d
-        return th, w
+        # Phase by phase: the last phase that has started at tau gives the state, with its
+        # elapsed time clamped to its duration (compiled in anyplan.trajectory._kernels).
+        th, w = _k.rotation_eval(np.ascontiguousarray(tau.ravel()), float(self.theta0),
+                                 float(self.omega0), np.asarray(self.durations, dtype=float),
+                                 np.asarray(self.alphas, dtype=float))
+        return th.reshape(tau.shape), w.reshape(tau.shape)
 
 
 def _rest_phases(dist: float, w0: float, wmax: float, amax: float) -> list[tuple[float, float]]:
