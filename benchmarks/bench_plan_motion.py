@@ -5,9 +5,10 @@ spline kernels) is extracted with ``git show`` into a temporary directory and im
 another name (``anyplan.trajectory`` in its sources renamed), so both implementations run in this
 process on the same inputs: BIT* paths (fixed seeds and batch counts, so the set is the same on
 every run) on paper-1..3 and random worlds, each with and without a virtual square across the
-straight route, from three robot states (at rest aligned, at rest turned 0.6 rad, driving at
-0.3 m/s while turning at 0.1 rad/s), at grid steps 0.05 m (the seq-bitstar agent's) and 0.02 m
-(plan_motion's default).
+straight route, from four robot states (at rest aligned, at rest turned 0.6 rad, driving at
+0.3 m/s while turning at 0.1 rad/s, and driving away from the path at 0.3 m/s turning at
+0.2 rad/s, which takes a brake + turn + smooth motion), at grid steps 0.05 m (the seq-bitstar
+agent's) and 0.02 m (plan_motion's default).
 
 Reported per grid step: the median and 90th percentile over the paths of the per-call time
 (best of ``--repeats``), old / new ratios, and the agreement of the two results (same kind,
@@ -85,7 +86,8 @@ def make_cases(n_random: int) -> list[dict]:
             th = spec.start[2]
             for state in (RobotState(start[0], start[1], th, 0.0, 0.0),
                           RobotState(start[0], start[1], th + 0.6, 0.0, 0.0),
-                          RobotState(start[0], start[1], th + 0.2, 0.3, 0.1)):
+                          RobotState(start[0], start[1], th + 0.2, 0.3, 0.1),
+                          RobotState(start[0], start[1], th + 2.5, 0.3, 0.2)):
                 cases.append({"name": f"{sc.name}-{i}{'+square' if virtual else ''}",
                               "path": res.path, "spec": spec, "state": state, "obstacles": obs})
     return cases
@@ -128,6 +130,7 @@ def main() -> None:
         print(f"{len(cases)} (path, state) cases; baseline {args.rev}; best of {args.repeats}")
         for gs in (0.05, 0.02):
             t_old, t_new, dur_d, st_d, n_same, s1, s5 = [], [], [], [], 0, [], []
+            kinds: dict[str, int] = {}
             for c in cases:
                 call_old = partial(old_plan_motion, c["path"], c["spec"], c["state"], c["obstacles"],
                                    0.0, margin=0.015, grid_step=gs)
@@ -140,13 +143,16 @@ def main() -> None:
                 n_same += same
                 dur_d.append(dd)
                 st_d.append(sd)
-                # Trajectory.sample: one time, and one Kanayama control step (5 times over 0.05 s)
-                t1 = np.array([0.5 * tr_new.t_end])
-                t5 = 0.5 * tr_new.t_end + 0.05 * np.linspace(0.0, 1.0, 5)
-                s1.append([best_time(partial(sample_many, tr, t1), 3) for tr in (tr_old, tr_new)])
-                s5.append([best_time(partial(sample_many, tr, t5), 3) for tr in (tr_old, tr_new)])
+                # Trajectory.sample: one time, and one Kanayama control step (5 times over 0.05 s),
+                # in the middle of the motion and at its start (braking or turning, if any)
+                kinds[tr_new.kind] = kinds.get(tr_new.kind, 0) + 1
+                for t0 in (0.5 * tr_new.t_end, tr_new.t_start + 0.01):
+                    t1 = np.array([t0])
+                    t5 = t0 + 0.05 * np.linspace(0.0, 1.0, 5)
+                    s1.append([best_time(partial(sample_many, tr, t1), 3) for tr in (tr_old, tr_new)])
+                    s5.append([best_time(partial(sample_many, tr, t5), 3) for tr in (tr_old, tr_new)])
             to, tn = np.array(t_old) * 1e3, np.array(t_new) * 1e3
-            print(f"\ngrid_step {gs} m: plan_motion per call [ms]")
+            print(f"\ngrid_step {gs} m: plan_motion per call [ms]; motions {kinds}")
             print(f"  old median {np.median(to):7.2f}  p90 {np.percentile(to, 90):7.2f}  "
                   f"max {to.max():7.2f}")
             print(f"  new median {np.median(tn):7.2f}  p90 {np.percentile(tn, 90):7.2f}  "
