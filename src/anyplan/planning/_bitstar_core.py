@@ -300,7 +300,7 @@ def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np
             stack: np.ndarray, nb: np.ndarray, nd: np.ndarray,
             ovx: np.ndarray, ovy: np.ndarray, ostarts: np.ndarray, opbox: np.ndarray,
             ocircles: np.ndarray, obounds: np.ndarray, max_iter: int) -> int:
-    """Run up to ``max_iter`` edge-queue iterations of one batch.
+    """Run one batch for up to ``max_iter`` units of work (edge pops plus vertex expansions).
 
     Returns RC_IMPROVED as soon as the goal's cost drops, RC_BATCH_DONE when the batch cannot
     improve the solution any more, RC_GROW when a queue may overflow (the caller enlarges the
@@ -308,13 +308,16 @@ def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np
     """
     n = N[N_N]
     limit = S[S_LIMIT]
-    for _ in range(max_iter):
+    work = 0  # edge pops + vertex expansions, bounded by max_iter per call
+    while work < max_iter:
         if ek.shape[0] - N[N_ES] < n + 8 or vk.shape[0] - N[N_VS] < 8:
             return RC_GROW
-        N[N_ITERS] += 1
+        work += 1
         c_best = S[S_CBEST]
         # Expand vertices while the best vertex key <= the best edge key.
         while N[N_VS] > 0:
+            if work >= max_iter:
+                return RC_BUDGET
             v = vp[0, 0]
             kv = vk[0]
             if IT[v, EXPB] == N[N_BATCH] or (IT[v, FLAGS] & F_VERTEX) == 0:
@@ -326,6 +329,7 @@ def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np
                 break
             N[N_VS] = heap_pop(vk, vp, N[N_VS])
             _expand(v, P, F, IT, ek, ep, cstart, citems, nstart, nitems, S, N, nb, nd)
+            work += 1
             if ek.shape[0] - N[N_ES] < n + 8:
                 return RC_GROW
         if N[N_ES] == 0:
@@ -339,6 +343,7 @@ def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np
         a = ep[0, 0]
         b = ep[0, 1]
         N[N_ES] = heap_pop(ek, ep, N[N_ES])
+        N[N_ITERS] += 1  # edges popped
         ga = F[a, G_T]
         chat = math.hypot(P[b, 0] - P[a, 0], P[b, 1] - P[a, 1])
         # g_T(a) + c_hat(a, b) + h_hat(b) < c_best ?

@@ -453,7 +453,7 @@ class BITStar(Planner):
             if rc == core.RC_BUDGET:
                 # Adapt the chunk so that ptc() is polled about every chunk_s seconds.
                 if dt < 0.5 * cfg.chunk_s:
-                    self._chunk = min(self._chunk * 2, 1 << 16)
+                    self._chunk = min(self._chunk * 2, 1 << 14)
                 elif dt > 2.0 * cfg.chunk_s:
                     self._chunk = max(self._chunk // 2, 1)
             elif rc == core.RC_BATCH_DONE:
