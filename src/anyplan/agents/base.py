@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import abc
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -13,7 +14,7 @@ from anyplan.registry import Registry
 from anyplan.world.robot import Command, RobotState
 from anyplan.world.scenario import Scenario
 
-__all__ = ["Observation", "Agent", "AGENTS", "make_agent"]
+__all__ = ["Observation", "Agent", "AgentStats", "TrackingLog", "AGENTS", "make_agent"]
 
 
 @dataclass(frozen=True)
@@ -50,6 +51,27 @@ class AgentStats:
     virtual_obstacles: list[dict[str, Any]] = field(default_factory=list)
     plans: list[dict[str, Any]] = field(default_factory=list)
     extra: dict[str, Any] = field(default_factory=dict)
+
+
+class TrackingLog:
+    """Running RMS and maximum distance [m] between the robot and its reference position.
+
+    :meth:`add` writes ``tracking_rms_m`` and ``tracking_max_m`` into an agent's ``stats.extra``.
+    """
+
+    def __init__(self) -> None:
+        self._sq = 0.0
+        self._n = 0
+        self._max = 0.0
+
+    def add(self, reference_xy: tuple[float, float], robot: RobotState, extra: dict[str, Any]) -> None:
+        """Record one control step's error."""
+        err = math.hypot(reference_xy[0] - robot.x, reference_xy[1] - robot.y)
+        self._sq += err * err
+        self._n += 1
+        self._max = max(self._max, err)
+        extra["tracking_rms_m"] = math.sqrt(self._sq / self._n)
+        extra["tracking_max_m"] = self._max
 
 
 class Agent(abc.ABC):

@@ -15,12 +15,11 @@ what lets the spline round the corners of BIT*'s path without cutting into an ob
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
 
-from anyplan.agents.base import Agent, Observation
+from anyplan.agents.base import Agent, Observation, TrackingLog
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
 from anyplan.trajectory.motion import plan_motion
 from anyplan.trajectory.trajectory import Trajectory
@@ -74,9 +73,7 @@ class BITStarAgent(Agent):
         self.failed = False
         self.controller = KanayamaController(self.spec, self.gains, self.control_dt)
         self._last_t: float | None = None
-        self._err_sq = 0.0
-        self._err_n = 0
-        self._err_max = 0.0
+        self.tracking = TrackingLog()
 
     # --- planning -----------------------------------------------------------------------------
     def _plan(self, obs: Observation) -> None:
@@ -134,12 +131,7 @@ class BITStarAgent(Agent):
         if traj is None:
             return Command(0.0, 0.0)
         x, y, _, _, _ = traj.state(obs.t)
-        err = math.hypot(x - obs.robot.x, y - obs.robot.y)
-        self._err_sq += err * err
-        self._err_n += 1
-        self._err_max = max(self._err_max, err)
-        self.stats.extra["tracking_rms_m"] = math.sqrt(self._err_sq / self._err_n)
-        self.stats.extra["tracking_max_m"] = self._err_max
+        self.tracking.add((x, y), obs.robot, self.stats.extra)
         return self.controller.command(traj, obs.robot, obs.t)
 
     def reference_state(self, t: float) -> RobotState | None:

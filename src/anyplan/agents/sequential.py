@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from anyplan.agents.base import Agent, AgentStats, Observation
+from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
 from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import SequentialBITStar, SequentialConfig, SequentialResult
@@ -126,9 +126,7 @@ class SequentialBITStarAgent(Agent):
         self._last_check = -math.inf
         self._last_replan = -math.inf
         self._seen: set[str] = set()
-        self._err_sq = 0.0
-        self._err_n = 0
-        self._err_max = 0.0
+        self.tracking = TrackingLog()
         ex = self.stats.extra
         ex.update({"statuses": {}, "iterations": [], "late_plans": 0, "plan_time_s": [],
                    "motion_time_s": [], "replan_times_s": [], "waits": 0})
@@ -247,12 +245,7 @@ class SequentialBITStarAgent(Agent):
         if traj is None:
             return Command(0.0, 0.0)
         x, y, _, _, _ = traj.state(t)
-        err = math.hypot(x - obs.robot.x, y - obs.robot.y)
-        self._err_sq += err * err
-        self._err_n += 1
-        self._err_max = max(self._err_max, err)
-        self.stats.extra["tracking_rms_m"] = math.sqrt(self._err_sq / self._err_n)
-        self.stats.extra["tracking_max_m"] = self._err_max
+        self.tracking.add((x, y), obs.robot, self.stats.extra)
         return self.controller.command(traj, obs.robot, t)
 
     def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
