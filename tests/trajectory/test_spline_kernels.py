@@ -85,3 +85,32 @@ def test_clean_path_keeps_turns_and_last_point():
     np.testing.assert_array_equal(clean_path(np.zeros((3, 2))), [[0.0, 0.0]])
     with pytest.raises(ValueError, match="at least one point"):
         clean_path(np.zeros((0, 2)))
+
+
+def _reduce(kk: np.ndarray, fu: np.ndarray, fc: np.ndarray) -> tuple[list, list, list]:
+    """Per interval, the first failing piece of least clearance (what the repair uses)."""
+    ks, idx = k.worst_per_group(kk.astype(np.int64), fc)
+    return ks.tolist(), fu[idx].tolist(), fc[idx].tolist()
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_branch_and_bound_finds_the_same_worst_pieces(seed):
+    # The repair's reduced certification (branch and bound) against the full one: same intervals,
+    # same worst piece and clearance in each, and the same margin when the curve is free.
+    from anyplan.trajectory.spline import _certify, _worst_failures
+
+    rng = np.random.default_rng(seed)
+    pts = np.cumsum(rng.uniform(-1.0, 2.0, (6, 2)), axis=0)
+    c = SmoothCurve(pts, start_heading=float(rng.uniform(-np.pi, np.pi)) if seed % 2 else None,
+                    grid_step=0.05)
+    shapes = [Circle(rng.uniform(pts.min(0), pts.max(0)), float(rng.uniform(0.1, 0.6))) for _ in range(4)]
+    obs = ObstacleSet(shapes)
+    true_min = float(obs.clearances(c.position(np.linspace(0.0, c.knots[-1], 20_000))).min())
+    for radius in (0.05, 0.3, true_min - 1e-3, true_min + 1e-3, true_min + 0.3):
+        if radius <= 0.0:
+            continue
+        kk, fu, fc, margin = _certify(c, obs, radius, 4)
+        ks, bu, bc, bmargin = _worst_failures(c, obs, radius, 4)
+        assert _reduce(kk, fu, fc) == (ks.tolist(), bu.tolist(), bc.tolist())
+        if len(kk) == 0:
+            assert bmargin == margin

@@ -341,6 +341,32 @@ def subdivide(u: np.ndarray, n: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
+def _chord_dev_one(x: np.ndarray, c: np.ndarray, a_u: float, b_u: float,
+                   i: int) -> tuple[float, float, float, float, float, int]:
+    """(r(a), r(b), M h^2 / 8) for one piece [a_u, b_u]; ``i``: piece guess for a_u (returned
+    updated)."""
+    xe = x[-1]
+    a = min(max(a_u, 0.0), xe)
+    b = min(max(b_u, 0.0), xe)
+    bi = min(max(b_u - 1e-12 * max(1.0, abs(b_u)), 0.0), xe)
+    i = _locate(x, a, i)
+    ia = i
+    t = a - x[i]
+    pax = c[i, 0, 0] + t * (c[i, 1, 0] + t * (c[i, 2, 0] + t * c[i, 3, 0]))
+    pay = c[i, 0, 1] + t * (c[i, 1, 1] + t * (c[i, 2, 1] + t * c[i, 3, 1]))
+    m2 = math.hypot(2.0 * c[i, 2, 0] + 6.0 * t * c[i, 3, 0], 2.0 * c[i, 2, 1] + 6.0 * t * c[i, 3, 1])
+    i = _locate(x, b, ia)
+    t = b - x[i]
+    pbx = c[i, 0, 0] + t * (c[i, 1, 0] + t * (c[i, 2, 0] + t * c[i, 3, 0]))
+    pby = c[i, 0, 1] + t * (c[i, 1, 1] + t * (c[i, 2, 1] + t * c[i, 3, 1]))
+    i = _locate(x, bi, ia)
+    t = bi - x[i]
+    m2b = math.hypot(2.0 * c[i, 2, 0] + 6.0 * t * c[i, 3, 0], 2.0 * c[i, 2, 1] + 6.0 * t * c[i, 3, 1])
+    h = b_u - a_u
+    return pax, pay, pbx, pby, max(m2, m2b) * h * h / 8.0, ia
+
+
+@njit(cache=True)
 def chord_deviation(x: np.ndarray, c: np.ndarray, a_u: np.ndarray,
                     b_u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For pieces [a_u, b_u] (within one cubic): end points (N, 2) each and the bound
@@ -350,28 +376,9 @@ def chord_deviation(x: np.ndarray, c: np.ndarray, a_u: np.ndarray,
     pa = np.empty((n, 2))
     pb = np.empty((n, 2))
     dev = np.empty(n)
-    xe = x[-1]
     i = 0
     for j in range(n):
-        a = min(max(a_u[j], 0.0), xe)
-        b = min(max(b_u[j], 0.0), xe)
-        bi = min(max(b_u[j] - 1e-12 * max(1.0, abs(b_u[j])), 0.0), xe)
-        i = _locate(x, a, i)
-        ia = i
-        t = a - x[i]
-        m2 = 0.0
-        for d in range(2):
-            pa[j, d] = c[i, 0, d] + t * (c[i, 1, d] + t * (c[i, 2, d] + t * c[i, 3, d]))
-        m2 = math.hypot(2.0 * c[i, 2, 0] + 6.0 * t * c[i, 3, 0], 2.0 * c[i, 2, 1] + 6.0 * t * c[i, 3, 1])
-        i = _locate(x, b, i)
-        t = b - x[i]
-        for d in range(2):
-            pb[j, d] = c[i, 0, d] + t * (c[i, 1, d] + t * (c[i, 2, d] + t * c[i, 3, d]))
-        i = _locate(x, bi, ia)
-        t = bi - x[i]
-        m2b = math.hypot(2.0 * c[i, 2, 0] + 6.0 * t * c[i, 3, 0], 2.0 * c[i, 2, 1] + 6.0 * t * c[i, 3, 1])
-        h = b_u[j] - a_u[j]
-        dev[j] = max(m2, m2b) * h * h / 8.0
+        pa[j, 0], pa[j, 1], pb[j, 0], pb[j, 1], dev[j], i = _chord_dev_one(x, c, a_u[j], b_u[j], i)
     return pa, pb, dev
 
 
@@ -749,3 +756,93 @@ def brake_eval(tau: np.ndarray, t_end: float, v0: float, w0: float, theta0: floa
     out[0] = np.interp(tt, grid, gx)
     out[1] = np.interp(tt, grid, gy)
     return out
+
+
+@njit(cache=True)
+def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarray, limit: float,
+                  radius: float, max_depth: int, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray,
+                  pbox: np.ndarray, circles: np.ndarray,
+                  bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """:func:`certify` reduced to what the repair uses, by branch and bound.
+
+    Returns, for each interpolation interval k (``point_u[k:k+2]``) that has a piece failing at
+    ``max_depth``, the first (in u) such piece of least certified clearance: (k, its midpoint,
+    its clearance), in order of k; and the margin, equal to :func:`certify`'s when nothing fails
+    (nothing is pruned then).
+
+    Pruning: the curve on a piece P = [a, b] stays within dev(P) = M h^2 / 8 of P's chord, so the
+    chord of any sub-piece P' (its ends are curve points; the dev(P)-neighbourhood of a segment
+    is convex) keeps an exact clearance >= clr(P) + dev(P) - dev(P), i.e. its certified clearance
+    is >= clr(P) - dev(P'), and dev(P') <= dev(P) / 16^(levels between them) (|r''| is linear
+    on P, so its maximum over P' is at most M). A failing piece whose bound (minus 1e-9 m for
+    rounding) is not below the interval's best so far cannot hold a strictly smaller value, and
+    since pieces are visited in order of u, a tie could not replace the first minimum either.
+    """
+    m = u.shape[0] - 1
+    nk = point_u.shape[0] - 1
+    has = np.zeros(nk, dtype=np.bool_)
+    best_c = np.empty(nk)
+    best_u = np.empty(nk)
+    margin = np.inf
+    # depth-first stack of pieces (a, b, depth, bound on the certified clearance at max_depth)
+    cap = 4 * (max_depth + 1) + 4
+    sa = np.empty(cap)
+    sb = np.empty(cap)
+    sd = np.empty(cap, dtype=np.int64)
+    slb = np.empty(cap)
+    hint = 0
+    for j in range(m):
+        kj = np.searchsorted(point_u, 0.5 * (u[j] + u[j + 1]), side="right") - 1
+        kj = min(max(kj, 0), nk - 1)
+        sa[0] = u[j]
+        sb[0] = u[j + 1]
+        sd[0] = 0
+        slb[0] = -np.inf
+        top = 1
+        while top > 0:
+            top -= 1
+            a = sa[top]
+            b = sb[top]
+            depth = sd[top]
+            if has[kj] and slb[top] >= best_c[kj]:
+                continue
+            pax, pay, pbx, pby, dev, hint = _chord_dev_one(x, c, a, b, hint)
+            cl = segment_clearance(pax, pay, pbx, pby, vx, vy, starts, pbox, circles, bounds, -1.0)
+            cj = cl - dev
+            if cj >= limit:
+                margin = min(margin, cj - radius)
+                continue
+            if depth == max_depth:
+                mid = 0.5 * (a + b)
+                k = np.searchsorted(point_u, mid, side="right") - 1
+                k = min(max(k, 0), nk - 1)
+                if not has[k] or cj < best_c[k]:
+                    has[k] = True
+                    best_c[k] = cj
+                    best_u[k] = mid
+                continue
+            lb = cj - dev / 16.0 ** (max_depth - depth) - 1e-9
+            if has[kj] and lb >= best_c[kj]:
+                continue
+            w = b - a
+            for p in range(3, -1, -1):  # pushed last to first: popped in order of u
+                sa[top] = a + w * (p / 4.0)
+                sb[top] = a + w * ((p + 1) / 4.0)
+                sd[top] = depth + 1
+                slb[top] = lb
+                top += 1
+    n = 0
+    for k in range(nk):
+        if has[k]:
+            n += 1
+    ks = np.empty(n, dtype=np.int64)
+    fu = np.empty(n)
+    fc = np.empty(n)
+    q = 0
+    for k in range(nk):
+        if has[k]:
+            ks[q] = k
+            fu[q] = best_u[k]
+            fc[q] = best_c[k]
+            q += 1
+    return ks, fu, fc, margin

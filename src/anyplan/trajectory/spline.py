@@ -260,6 +260,15 @@ def _certify(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
     return curve.point_index(fail_u), fail_u, fail_c, margin
 
 
+def _worst_failures(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
+                    max_depth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """What the repair uses of :func:`_certify`: per interpolation interval with failing pieces,
+    its first failing piece of least certified clearance (k, midpoint u, clearance), found by
+    branch and bound (see ``_kernels.certify_worst``); the margin is valid when nothing fails."""
+    return _k.certify_worst(curve._x, curve._c, curve.u_grid, curve.point_u, radius - COLLISION_EPS,
+                            float(radius), int(max_depth), *obstacles.kernel_args)
+
+
 def curve_clearance_ok(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
                        max_depth: int = 4) -> tuple[bool, np.ndarray, float]:
     """Certified check that a disc of ``radius`` [m] swept along ``curve`` touches nothing.
@@ -333,7 +342,7 @@ def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
         if not curve.is_regular():
             # a cusp comes from the start heading, which no repair changes
             return SmoothingResult(None, rnd, len(pts) - n0, float("nan"))
-        kk, fu, fc, margin = _certify(curve, obstacles, radius, 4)
+        kk, fu, fc, margin = _worst_failures(curve, obstacles, radius, 4)
         if len(kk) == 0:
             return SmoothingResult(curve, rnd, len(pts) - n0, margin)
         if rnd == max_rounds:
