@@ -77,7 +77,11 @@ class SequentialConfig:
         anchor: Where the square is centred: ``"robot"`` (the paper: the robot's reference
             position at the collision), ``"obstacle"`` (the obstacle's centre then) or
             ``"midpoint"``.
-        wait_delays_s: Departure delays tried when the loop fails.
+        wait_delays_s: Departure delays tried when the loop fails (on the first and the last
+            path found).
+        max_time_s: Wall-clock cap [s] on the iterations of one replanning; the waiting
+            search that may follow has the same cap again. A replanning that runs out of time
+            returns its best effort (the motion whose first collision is latest).
         prediction_dt: The motion is resampled every ``prediction_dt`` seconds for the
             collision prediction (certified: the contact distance is enlarged by the
             interpolation error bound, at most v_max * prediction_dt / 2); None predicts on the
@@ -96,12 +100,13 @@ class SequentialConfig:
     anchor: str = "robot"
     wait_delays_s: tuple[float, ...] = (0.5, 1.0, 2.0, 3.0, 5.0, 8.0, 12.0)
     prediction_dt: float | None = 0.02
+    max_time_s: float = 0.5
     bitstar: BITStarConfig = field(default_factory=BITStarConfig)
 
     def __post_init__(self) -> None:
         if not (isinstance(self.max_iterations, int) and self.max_iterations >= 1):
             raise ValueError(f"max_iterations: must be an int >= 1, got {self.max_iterations!r}")
-        for name in ("first_budget_s", "iteration_budget_s", "side_factor", "min_side"):
+        for name in ("first_budget_s", "iteration_budget_s", "side_factor", "min_side", "max_time_s"):
             if not float(getattr(self, name)) > 0.0:
                 raise ValueError(f"{name}: must be > 0, got {getattr(self, name)!r}")
         if self.margin < 0.0:
@@ -279,8 +284,11 @@ class SequentialBITStar:
         best: SequentialResult | None = None
         blocked = False
         status = "collision_predicted"
+        deadline = time.perf_counter() + cfg.max_time_s
         for it in range(cfg.max_iterations):
             t0 = time.perf_counter()
+            if it > 0 and t0 > deadline:
+                break
             if not cfg.warm_start and it > 0:
                 planner = BITStar(problem.with_shapes([s.shape for s in squares]), cfg.bitstar,
                                   rng=self.rng)
@@ -317,7 +325,7 @@ class SequentialBITStar:
                 planner.add_obstacles([vo.shape])
         # Algorithm 1 did not converge: try waiting before departing on the paths found.
         t1 = time.perf_counter()
-        waited = self._try_waiting(candidates, predictions)
+        waited = self._try_waiting(candidates, predictions, time.perf_counter() + cfg.max_time_s)
         motion_time += time.perf_counter() - t1
         if waited is not None:
             path, shapes, delay, motion = waited
@@ -353,15 +361,16 @@ class SequentialBITStar:
                                s < side)
 
     def _try_waiting(self, candidates: list[tuple[np.ndarray, list[Shape]]],
-                     predictions: Sequence[PredictedObstacle]
+                     predictions: Sequence[PredictedObstacle], deadline: float
                      ) -> tuple[np.ndarray, list[Shape], float, TimedMotion] | None:
         if not candidates:
             return None
-        # Shortest paths first, and among equals the ones with fewer squares.
-        order = sorted(range(len(candidates)),
-                       key=lambda i: (float(np.sum(np.hypot(*np.diff(candidates[i][0], axis=0).T))), i))
+        # The first path (shortest, no squares) and the last (around every square so far).
+        order = [0] if len(candidates) == 1 else [0, len(candidates) - 1]
         for delay in self.config.wait_delays_s:
             for i in order:
+                if time.perf_counter() > deadline:
+                    return None
                 path, shapes = candidates[i]
                 motion = self.motion_fn(path, shapes, delay)
                 if first_collision(motion, predictions, self.robot_radius, margin=self.config.margin,
