@@ -139,6 +139,37 @@ def _passes(ds: np.ndarray, mvc: np.ndarray, kmax: np.ndarray, dkmax: np.ndarray
     return x, back
 
 
+@njit(cache=True)
+def _profile(s: np.ndarray, kmax: np.ndarray, dkmax: np.ndarray, v_max: float, omega_max: float,
+             a2: float, al: float, x0: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """Speeds and times on the grid ``s`` (and the backward pass's start value, in v^2)."""
+    n = s.shape[0]
+    ds = np.empty(n - 1)
+    for i in range(n - 1):
+        ds[i] = s[i + 1] - s[i]
+    # Maximum velocity curve (in x = v^2) per interval, then per node (min of both sides).
+    xi = np.empty(n - 1)
+    for i in range(n - 1):
+        xi[i] = min(min(v_max ** 2, (omega_max / kmax[i]) ** 2), al / dkmax[i])
+    mvc = np.empty(n)
+    mvc[0] = xi[0]
+    mvc[n - 1] = xi[n - 2]
+    for i in range(1, n - 1):
+        mvc[i] = min(xi[i - 1], xi[i])
+    x, back = _passes(ds, mvc, kmax, dkmax, a2, al, x0)
+    v = np.empty(n)
+    for i in range(n):
+        v[i] = math.sqrt(max(x[i], 0.0))
+    t = np.empty(n)
+    t[0] = 0.0
+    acc = 0.0
+    for i in range(n - 1):
+        vs = v[i] + v[i + 1]
+        acc += 2.0 * ds[i] / vs if vs > 0.0 else np.inf
+        t[i + 1] = acc
+    return v, t, back[0]
+
+
 def time_parameterize(curve: SmoothCurve, spec: RobotSpec, v_start: float = 0.0) -> SpeedProfile:
     """Time-optimal (on the grid) speed profile from ``v_start`` to rest at the curve's end.
 
@@ -151,25 +182,11 @@ def time_parameterize(curve: SmoothCurve, spec: RobotSpec, v_start: float = 0.0)
         A :class:`SpeedProfile` that satisfies all four limits everywhere along the curve.
     """
     s, u = curve.s_grid, curve.u_grid
-    ds = np.diff(s)
     kmax, dkmax = _interval_bounds(curve, u)
-    a2, al = 2.0 * spec.a_max, spec.alpha_max
-    # Maximum velocity curve (in x = v^2) per interval, then per node (min of both sides).
-    xi = np.minimum(spec.v_max ** 2, (spec.omega_max / kmax) ** 2)
-    xi = np.minimum(xi, al / dkmax)
-    mvc = np.empty(len(s))
-    mvc[0] = xi[0]
-    mvc[-1] = xi[-1]
-    mvc[1:-1] = np.minimum(xi[:-1], xi[1:])
-
     v0 = max(float(v_start), 0.0)
-    x, back = _passes(ds, mvc, kmax, dkmax, a2, al, v0 * v0)
-    feasible = v0 * v0 <= back[0] * (1.0 + 1e-9) + 1e-12
-    v = np.sqrt(np.maximum(x, 0.0))
-    vs = v[:-1] + v[1:]
-    with np.errstate(divide="ignore"):
-        dt = np.where(vs > 0.0, 2.0 * ds / np.where(vs > 0.0, vs, 1.0), np.inf)
-    t = np.concatenate([[0.0], np.cumsum(dt)])
+    v, t, back0 = _profile(s, kmax, dkmax, float(spec.v_max), float(spec.omega_max),
+                           2.0 * spec.a_max, float(spec.alpha_max), v0 * v0)
+    feasible = v0 * v0 <= back0 * (1.0 + 1e-9) + 1e-12
     return SpeedProfile(s=s.copy(), u=u.copy(), v=v, t=t, kappa_max=kmax, dkappa_max=dkmax,
                         feasible=bool(feasible), v_start_requested=float(v_start))
 

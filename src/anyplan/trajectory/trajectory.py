@@ -59,14 +59,27 @@ class CurveSegment(Segment):
         self.t0 = float(t0)
         self.t1 = self.t0 + profile.duration
         self.length = curve.length
-        # |d position/dt| = |r'(u(s))| u'(s) v: measure the first factor (1 to ~1e-6) finely,
-        # as chord lengths over 8 equal parts of each profile interval.
         c = curve
         self._args = (c._x, c._c, c.s_grid, c.u_grid, c._dus, c.length,
                       np.ascontiguousarray(profile.s, dtype=float),
                       np.ascontiguousarray(profile.v, dtype=float),
                       np.ascontiguousarray(profile.t, dtype=float))
-        self.max_speed = (_k.speed_bound(*self._args[:8], 8) * 1.01) if len(profile.s) > 1 else 0.0
+        self._max_speed: float | None = None
+
+    @property
+    def max_speed(self) -> float:  # type: ignore[override]
+        """Bound on the speed of the reference position [m/s] (computed on first use)."""
+        # |d position/dt| = |r'(u(s))| u'(s) v: measure the first factor (1 to ~1e-6) finely,
+        # as chord lengths over 8 equal parts of each profile interval, times the larger end
+        # speed of the interval, plus 1 %.
+        if self._max_speed is None:
+            self._max_speed = ((_k.speed_bound(*self._args[:8], 8) * 1.01)
+                               if len(self.profile.s) > 1 else 0.0)
+        return self._max_speed
+
+    @max_speed.setter
+    def max_speed(self, value: float) -> None:
+        self._max_speed = float(value)
 
     def sample(self, t: np.ndarray) -> Sample:
         t = np.asarray(t, dtype=float)
@@ -175,10 +188,7 @@ class Trajectory:
         self.certified_free = certified_free
         self.info = dict(info or {})
         self._starts = np.array([s.t0 for s in self.segments])
-        pts = [s.path_points(0.05) for s in self.segments]
-        path = np.vstack(pts)
-        keep = np.concatenate([[True], np.hypot(*np.diff(path, axis=0).T) > 1e-12])
-        self._path = path[keep]
+        self._path: np.ndarray | None = None  # built on first use (see path)
 
     @property
     def t_start(self) -> float:
@@ -208,6 +218,10 @@ class Trajectory:
     @property
     def path(self) -> np.ndarray:
         """The geometric curve followed, as points (M, 2) [m] about 5 cm apart."""
+        if self._path is None:
+            path = np.vstack([s.path_points(0.05) for s in self.segments])
+            keep = np.concatenate([[True], np.hypot(*np.diff(path, axis=0).T) > 1e-12])
+            self._path = path[keep]
         return self._path
 
     def sample(self, t: np.ndarray | float) -> Sample:
