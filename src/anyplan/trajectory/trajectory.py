@@ -83,7 +83,9 @@ class CurveSegment(Segment):
 
     def sample(self, t: np.ndarray) -> Sample:
         t = np.asarray(t, dtype=float)
-        out = _k.curve_sample(*self._args, np.ascontiguousarray(t.ravel()) - self.t0)
+        out = _k.curve_sample(*self._args, t.ravel() - self.t0)
+        if t.ndim == 1:
+            return out[0], out[1], out[2], out[3], out[4]
         return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
 
     def path_points(self, step: float) -> np.ndarray:
@@ -150,12 +152,16 @@ class BrakeSegment(Segment):
 
     def sample(self, t: np.ndarray) -> Sample:
         t = np.asarray(t, dtype=float)
-        out = _k.brake_eval(np.ascontiguousarray(t.ravel()) - self.t0, self.t1 - self.t0, self.v0,
+        out = _k.brake_eval(t.ravel() - self.t0, self.t1 - self.t0, self.v0,
                             self.w0, self.theta0, self.a, self.al, self._tau, self._x, self._y)
         return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
 
     def path_points(self, step: float) -> np.ndarray:
         return np.column_stack([self._x, self._y])
+
+
+#: Segment types whose ``sample`` returns new arrays that share no memory.
+_FRESH = (CurveSegment, TurnSegment, BrakeSegment)
 
 
 class Trajectory:
@@ -232,25 +238,36 @@ class Trajectory:
         """
         t = np.asarray(t, dtype=float)
         flat = t.ravel()
-        nseg = len(self.segments)
-        idx = (np.zeros(flat.shape, dtype=np.int64) if nseg == 1 else
-               np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0, nseg - 1))
-        if flat.size and (nseg == 1 or idx.min() == idx.max()):
-            # one segment serves every time (the common case: a control step or one query);
-            # copies, as in the general case, so that no two outputs share memory
-            out = [np.array(v, dtype=float).reshape(flat.shape)
-                   for v in self.segments[int(idx[0])].sample(flat)]
+        segs = self.segments
+        nseg = len(segs)
+        if nseg == 1:
+            k0, single = 0, True
+        else:
+            idx = np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0, nseg - 1)
+            k0 = int(idx[0]) if flat.size else 0
+            single = flat.size > 0 and bool(np.all(idx == k0))
+        if single:
+            # one segment serves every time (the common case: a control step or one query)
+            seg = segs[k0]
+            vals = seg.sample(flat)
+            # our segments return fresh, separate arrays; copy others' (they may share memory)
+            if type(seg) in _FRESH:
+                out = [np.asarray(v, dtype=float).reshape(flat.shape) for v in vals]
+            else:
+                out = [np.array(v, dtype=float).reshape(flat.shape) for v in vals]
         else:
             out = [np.empty(flat.shape) for _ in range(5)]
             for k in np.unique(idx):
                 m = idx == k
-                vals = self.segments[k].sample(flat[m])
+                vals = segs[k].sample(flat[m])
                 for o, val in zip(out, vals, strict=True):
                     o[m] = val
-        after = flat >= self.t_end
+        after = flat >= segs[-1].t1
         if after.any():
-            out[3] = np.where(after, 0.0, out[3])
-            out[4] = np.where(after, 0.0, out[4])
+            out[3][after] = 0.0
+            out[4][after] = 0.0
+        if t.ndim == 1:
+            return out[0], out[1], out[2], out[3], out[4]
         return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
 
     def positions(self, t: np.ndarray | float) -> np.ndarray:
