@@ -20,6 +20,7 @@ import time
 import numpy as np
 
 from anyplan.agents.base import Agent, Observation, TrackingLog
+from anyplan.agents.warmup import warm_up_kernels
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
 from anyplan.trajectory.motion import plan_motion
 from anyplan.trajectory.trajectory import Trajectory
@@ -64,6 +65,7 @@ class BITStarAgent(Agent):
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
         from anyplan.agents.base import AgentStats
 
+        warm_up_kernels()  # compile or load machine code now, not inside the timed planning
         self.stats = AgentStats()
         self.scenario = scenario
         self.spec = scenario.robot

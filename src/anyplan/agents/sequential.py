@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
+from anyplan.agents.warmup import warm_up_kernels
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
 from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import SequentialBITStar, SequentialConfig, SequentialResult
@@ -110,6 +111,7 @@ class SequentialBITStarAgent(Agent):
 
     # --- lifecycle -------------------------------------------------------------------------------
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
+        warm_up_kernels()  # compile or load machine code now, not inside a timed replanning
         self.stats = AgentStats()
         self.spec = scenario.robot
         self.obstacles = scenario.obstacle_set()
@@ -171,20 +173,26 @@ class SequentialBITStarAgent(Agent):
         if self.planning_delay != "measured":
             d = float(self.planning_delay)
         else:
+            # 1.5 x the longest of the last five replannings, within [0.1 s, max_time_s]: an
+            # outlier must not park the robot on a stale reference for long; a replanning that
+            # takes longer than expected is re-timed when it ends (see _replan).
             recent = self.stats.planning_times_s[-5:]
-            d = 1.5 * max(recent) if recent else 0.05
+            d = min(max(1.5 * max(recent), 0.1), self.config.max_time_s) if recent else 0.1
         return max(dt, math.ceil(d / dt - 1e-9) * dt)
+
+    def _state_at(self, obs: Observation, t: float) -> RobotState:
+        """The state the robot will have at time ``t`` [s]: on its reference, or at rest."""
+        if self.trajectory is None:
+            r = obs.robot
+            return RobotState(r.x, r.y, r.theta, 0.0, 0.0)
+        return RobotState(*self.trajectory.state(t))
 
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
         dt = self._dt or 0.05
         t = obs.t
         d = self._expected_delay(dt)
         t_ready = t + d
-        if self.trajectory is None:
-            r = obs.robot
-            state = RobotState(r.x, r.y, r.theta, r.v, r.omega)
-        else:
-            state = RobotState(*self.trajectory.state(t_ready))
+        state = self._state_at(obs, t_ready)
         self.loop.motion_fn = self._motion_fn(state, t_ready)
         w0 = time.perf_counter()
         res: SequentialResult = self.loop.replan(np.array([state.x, state.y]),
@@ -210,19 +218,24 @@ class SequentialBITStarAgent(Agent):
             ex["progress"] = [[float(a), float(b)] for a, b in res.history]
         if res.motion is None:
             return  # keep the current reference (or stay put): the next check tries again
+        motion: Trajectory = res.motion  # type: ignore[assignment]
         t_switch = t_ready
         if self.planning_delay == "measured" and wall > d + 1e-9:
+            # Late: the computation outlasted the expected delay. The robot went on with its
+            # current reference (or stayed at rest) meanwhile, so the new motion is re-timed
+            # from the state it will have when the new plan is really ready. The re-timing
+            # time counts as planning time too.
+            w1 = time.perf_counter()
             ex["late_plans"] += 1
             t_switch = t + math.ceil(wall / dt - 1e-9) * dt
-        st.plans.append({"t": t, "t_start": t_ready, "path": np.asarray(res.path).tolist(),
+            state = self._state_at(obs, t_switch)
+            shapes = [v.shape for v in res.virtual_obstacles]
+            motion = self._motion_fn(state, t_switch)(res.path, shapes, res.delay_s)
+            st.planning_times_s[-1] = wall + (time.perf_counter() - w1)
+        st.plans.append({"t": t, "t_start": t_switch, "path": np.asarray(res.path).tolist(),
                          "status": res.status, "virtual_obstacles": len(res.virtual_obstacles),
                          "delay_s": res.delay_s})
-        motion: Trajectory = res.motion  # type: ignore[assignment]
-        if self.trajectory is None:
-            self.trajectory = motion
-            self.pending = None
-        else:
-            self.pending = (t_switch, motion)
+        self.pending = (t_switch, motion)
 
     # --- control ---------------------------------------------------------------------------------
     def act(self, obs: Observation) -> Command:
@@ -235,11 +248,15 @@ class SequentialBITStarAgent(Agent):
         if self.pending is not None and t >= self.pending[0] - 1e-9:
             self.trajectory = self.pending[1]
             self.pending = None
-        if self.trajectory is None:
+        if self.trajectory is None and self.pending is None:
+            # The first plan: the robot stays at rest while it is computed.
             self._replan(obs, preds, "initial")
             self._last_check = t
             self._seen = {p.name for p in preds}
-        elif self.pending is None and t - self._last_check >= self.check_period_s - 1e-9:
+            if self.pending is not None and t >= self.pending[0] - 1e-9:
+                self.trajectory, self.pending = self.pending[1], None
+        elif (self.trajectory is not None and self.pending is None
+              and t - self._last_check >= self.check_period_s - 1e-9):
             self._check(obs, preds)
         traj = self.trajectory
         if traj is None:

@@ -66,7 +66,10 @@ def cmd_run(args: argparse.Namespace) -> int:
             check_target(args.animate, args.speed)
         except ValueError as exc:
             raise UsageError(f"run: --animate: {exc}") from None
-    result = simulate(scenario, make_agent(args.planner), seed=args.seed, config=cfg)
+    agent = make_agent(args.planner)
+    if args.planner in ("bitstar", "seq-bitstar"):
+        _prepare_kernels()
+    result = simulate(scenario, agent, seed=args.seed, config=cfg)
     (out / "result.json").write_text(json.dumps(result.to_dict(), indent=1))
     if not args.no_plot:
         from anyplan.viz.run import save_run_figure
@@ -78,6 +81,20 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         print(f"  animation      {animate_run(scenario, result, args.animate, speed=args.speed)}")
     return 0
+
+
+def _prepare_kernels() -> None:
+    """Load (or, the first time on a machine, compile) the planners' machine code up front."""
+    import sys
+    import time
+
+    from anyplan.agents.warmup import warm_up_kernels
+
+    sys.stderr.write("anyplan: loading compiled kernels (the first run on a machine compiles "
+                     "them once, which takes a minute)\n")
+    t0 = time.perf_counter()
+    warm_up_kernels()
+    sys.stderr.write(f"anyplan: kernels ready in {time.perf_counter() - t0:.1f} s\n")
 
 
 def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
