@@ -116,3 +116,31 @@ def test_agent_refuses_bad_options():
 @given(seed=st.integers(0, 10_000), n_moving=st.integers(1, 6))
 def test_random_scenarios_many_slow(seed, n_moving):
     test_random_scenarios_predicted_motions_are_collision_free.hypothesis.inner_test(seed, n_moving)
+
+
+def test_a_slow_first_plan_keeps_the_robot_at_rest_until_it_is_ready():
+    import time as _time
+
+    class SlowAgent(SequentialBITStarAgent):
+        def reset(self, scenario, rng):
+            super().reset(scenario, rng)
+            inner = self.loop.replan
+
+            def replan(*args, **kwargs):
+                _time.sleep(0.4)  # a slow computer: the plan is ready 0.4 s (wall) later
+                return inner(*args, **kwargs)
+
+            self.loop.replan = replan
+
+    sc = load_scenario("paper-1")
+    agent = SlowAgent()
+    res = simulate(sc, agent, seed=0)
+    assert res.planning_times_s[0] >= 0.4
+    assert agent.stats.extra["late_plans"] >= 1
+    t_start = res.plans[0]["t_start"]
+    assert t_start >= 0.4 - 1e-9
+    tr = res.trajectory_array
+    # At rest (no command can have moved it) until the plan was ready.
+    before = tr[tr[:, 0] <= t_start - 0.05 + 1e-9]
+    assert np.all(before[:, 4] == 0.0) and np.allclose(before[:, 1:3], sc.robot.start[:2])
+    assert res.reached_goal and not res.collision
