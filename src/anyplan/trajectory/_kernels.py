@@ -766,17 +766,19 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
     """:func:`certify` reduced to what the repair uses, by branch and bound.
 
     Returns, for each interpolation interval k (``point_u[k:k+2]``) that has a piece failing at
-    ``max_depth``, the first (in u) such piece of least certified clearance: (k, its midpoint,
-    its clearance), in order of k; and the margin, equal to :func:`certify`'s when nothing fails
-    (nothing is pruned then).
+    ``max_depth``, the failing piece of least certified clearance, the first in u among equal
+    ones: (k, its midpoint, its clearance), in order of k; and the margin, equal to
+    :func:`certify`'s when nothing fails (nothing is pruned then).
 
-    Pruning: the curve on a piece P = [a, b] stays within dev(P) = M h^2 / 8 of P's chord, so the
-    chord of any sub-piece P' (its ends are curve points; the dev(P)-neighbourhood of a segment
-    is convex) keeps an exact clearance >= clr(P) + dev(P) - dev(P), i.e. its certified clearance
-    is >= clr(P) - dev(P'), and dev(P') <= dev(P) / 16^(levels between them) (|r''| is linear
-    on P, so its maximum over P' is at most M). A failing piece whose bound (minus 1e-9 m for
-    rounding) is not below the interval's best so far cannot hold a strictly smaller value, and
-    since pieces are visited in order of u, a tie could not replace the first minimum either.
+    Bound: the curve on a piece P = [a, b] stays within dev(P) = M h^2 / 8 of P's chord, so the
+    chord of any sub-piece P' (its ends are curve points, and the dev(P)-neighbourhood of a
+    segment is convex) has an exact clearance >= clr(P) + dev(P) - dev(P), i.e. a certified
+    clearance >= clr(P) - dev(P'), with dev(P') <= dev(P) / 16^(levels between them) (|r''| is
+    linear on P, so its maximum over P' is at most M). A piece whose bound (minus 1e-9 m for
+    rounding) is not below its interval's best so far holds only strictly larger values and is
+    skipped. Every grid piece is tested first; the failing ones are then searched from the
+    lowest certified clearance up, and each piece's failing children likewise, so that the best
+    is found early.
     """
     m = u.shape[0] - 1
     nk = point_u.shape[0] - 1
@@ -784,65 +786,109 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
     best_c = np.empty(nk)
     best_u = np.empty(nk)
     margin = np.inf
-    # depth-first stack of pieces (a, b, depth, bound on the certified clearance at max_depth)
-    cap = 4 * (max_depth + 1) + 4
+    # 1. every grid piece
+    fa = np.empty(m)
+    fb = np.empty(m)
+    fc = np.empty(m)
+    fd = np.empty(m)
+    nf = 0
+    hint = 0
+    for j in range(m):
+        pax, pay, pbx, pby, dev, hint = _chord_dev_one(x, c, u[j], u[j + 1], hint)
+        cl = segment_clearance(pax, pay, pbx, pby, vx, vy, starts, pbox, circles, bounds, -1.0)
+        cj = cl - dev
+        if cj >= limit:
+            margin = min(margin, cj - radius)
+        else:
+            fa[nf] = u[j]
+            fb[nf] = u[j + 1]
+            fc[nf] = cj
+            fd[nf] = dev
+            nf += 1
+    # 2. depth-first search below the failing ones, lowest certified clearance first
+    cap = 4 * max_depth + 4
     sa = np.empty(cap)
     sb = np.empty(cap)
     sd = np.empty(cap, dtype=np.int64)
-    slb = np.empty(cap)
-    hint = 0
-    for j in range(m):
-        kj = np.searchsorted(point_u, 0.5 * (u[j] + u[j + 1]), side="right") - 1
+    sc = np.empty(cap)
+    sv = np.empty(cap)
+    ca = np.empty(4)
+    cb = np.empty(4)
+    cc = np.empty(4)
+    cd = np.empty(4)
+    order = np.argsort(fc[:nf], kind="mergesort")
+    for r in range(nf):
+        j = order[r]
+        kj = np.searchsorted(point_u, 0.5 * (fa[j] + fb[j]), side="right") - 1
         kj = min(max(kj, 0), nk - 1)
-        sa[0] = u[j]
-        sb[0] = u[j + 1]
+        sa[0] = fa[j]
+        sb[0] = fb[j]
         sd[0] = 0
-        slb[0] = -np.inf
+        sc[0] = fc[j]
+        sv[0] = fd[j]
         top = 1
         while top > 0:
             top -= 1
             a = sa[top]
             b = sb[top]
             depth = sd[top]
-            if has[kj] and slb[top] >= best_c[kj]:
-                continue
-            pax, pay, pbx, pby, dev, hint = _chord_dev_one(x, c, a, b, hint)
-            cl = segment_clearance(pax, pay, pbx, pby, vx, vy, starts, pbox, circles, bounds, -1.0)
-            cj = cl - dev
-            if cj >= limit:
-                margin = min(margin, cj - radius)
-                continue
+            cj = sc[top]
             if depth == max_depth:
                 mid = 0.5 * (a + b)
                 k = np.searchsorted(point_u, mid, side="right") - 1
                 k = min(max(k, 0), nk - 1)
-                if not has[k] or cj < best_c[k]:
+                if not has[k] or cj < best_c[k] or (cj == best_c[k] and mid < best_u[k]):
                     has[k] = True
                     best_c[k] = cj
                     best_u[k] = mid
                 continue
-            lb = cj - dev / 16.0 ** (max_depth - depth) - 1e-9
-            if has[kj] and lb >= best_c[kj]:
+            if has[kj] and cj - sv[top] / 16.0 ** (max_depth - depth) - 1e-9 >= best_c[kj]:
                 continue
             w = b - a
-            for p in range(3, -1, -1):  # pushed last to first: popped in order of u
-                sa[top] = a + w * (p / 4.0)
-                sb[top] = a + w * ((p + 1) / 4.0)
+            n_c = 0
+            h2 = 0
+            for p in range(4):
+                a2 = a + w * (p / 4.0)
+                b2 = a + w * ((p + 1) / 4.0)
+                pax, pay, pbx, pby, dev, h2 = _chord_dev_one(x, c, a2, b2, h2)
+                cl = segment_clearance(pax, pay, pbx, pby, vx, vy, starts, pbox, circles, bounds,
+                                       -1.0)
+                c2 = cl - dev
+                if c2 >= limit:
+                    margin = min(margin, c2 - radius)
+                    continue
+                ca[n_c] = a2
+                cb[n_c] = b2
+                cc[n_c] = c2
+                cd[n_c] = dev
+                n_c += 1
+            # push the failing children so that the lowest (then the first in u) pops first
+            for _ in range(n_c):
+                worst = -1
+                for q in range(n_c):
+                    if cd[q] < 0.0:
+                        continue
+                    if worst < 0 or cc[q] > cc[worst] or (cc[q] == cc[worst] and ca[q] > ca[worst]):
+                        worst = q
+                sa[top] = ca[worst]
+                sb[top] = cb[worst]
                 sd[top] = depth + 1
-                slb[top] = lb
+                sc[top] = cc[worst]
+                sv[top] = cd[worst]
                 top += 1
+                cd[worst] = -1.0
     n = 0
     for k in range(nk):
         if has[k]:
             n += 1
     ks = np.empty(n, dtype=np.int64)
     fu = np.empty(n)
-    fc = np.empty(n)
+    fcl = np.empty(n)
     q = 0
     for k in range(nk):
         if has[k]:
             ks[q] = k
             fu[q] = best_u[k]
-            fc[q] = best_c[k]
+            fcl[q] = best_c[k]
             q += 1
-    return ks, fu, fc, margin
+    return ks, fu, fcl, margin
