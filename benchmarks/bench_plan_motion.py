@@ -158,6 +158,9 @@ def main() -> None:
             print(f"  new median {np.median(tn):7.2f}  p90 {np.percentile(tn, 90):7.2f}  "
                   f"max {tn.max():7.2f}")
             r = to / tn
+            worst = int(np.argmax(tn))
+            print(f"  slowest new: {cases[worst]['name']} from {cases[worst]['state']} "
+                  f"({tn[worst]:.2f} ms, old {to[worst]:.2f} ms)")
             print(f"  ratio old/new: of medians {np.median(to) / np.median(tn):5.2f}, per path "
                   f"median {np.median(r):5.2f} (min {r.min():5.2f}, max {r.max():5.2f})")
             print(f"  agreement: same kind/feasible/certified {n_same}/{len(cases)}, "

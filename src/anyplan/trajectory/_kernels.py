@@ -772,11 +772,12 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
 
     Bound: the curve on a piece P = [a, b] stays within dev(P) = M h^2 / 8 of P's chord, so the
     chord of any sub-piece P' (its ends are curve points, and the dev(P)-neighbourhood of a
-    segment is convex) has an exact clearance >= clr(P) + dev(P) - dev(P), i.e. a certified
-    clearance >= clr(P) - dev(P'), with dev(P') <= dev(P) / 16^(levels between them) (|r''| is
-    linear on P, so its maximum over P' is at most M). A piece whose bound (minus 1e-9 m for
-    rounding) is not below its interval's best so far holds only strictly larger values and is
-    skipped. Every grid piece is tested first; the failing ones are then searched from the
+    segment is convex) has an exact clearance >= clr(P) + dev(P) - dev(P) and >= 0, i.e. a
+    certified clearance >= max(clr(P), 0) - dev(P'), with dev(P') <= dev(P) / 16^(levels between
+    them) (|r''| is linear on P, so its maximum over P' is at most M). A piece whose bound, minus
+    a rounding allowance of 1e-11 times the size of the coordinates (the computed distances are
+    off by a few ulp of it), is not below its interval's best so far holds only strictly larger
+    values and is skipped. Every grid piece is tested first; the failing ones are then searched from the
     lowest certified clearance up, and each piece's failing children likewise, so that the best
     is found early.
     """
@@ -786,6 +787,18 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
     best_c = np.empty(nk)
     best_u = np.empty(nk)
     margin = np.inf
+    # Rounding allowance of the bound: distances here are computed from coordinates of size
+    # <= scale with absolute errors of a few ulp(scale) ~ 1e-15 scale; allow 1e-11 scale.
+    scale = 1.0
+    for j in range(c.shape[0]):
+        scale = max(scale, abs(c[j, 0, 0]), abs(c[j, 0, 1]))
+    for j in range(bounds.shape[0]):
+        scale = max(scale, abs(bounds[j]))
+    for j in range(vx.shape[0]):
+        scale = max(scale, abs(vx[j]), abs(vy[j]))
+    for j in range(circles.shape[0]):
+        scale = max(scale, abs(circles[j, 0]) + abs(circles[j, 2]), abs(circles[j, 1]) + abs(circles[j, 2]))
+    slack = 1e-11 * scale
     # 1. every grid piece
     fa = np.empty(m)
     fb = np.empty(m)
@@ -842,7 +855,9 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
                     best_c[k] = cj
                     best_u[k] = mid
                 continue
-            if has[kj] and cj - sv[top] / 16.0 ** (max_depth - depth) - 1e-9 >= best_c[kj]:
+            # chord clearances are >= 0: the sub-pieces' certified clearances are
+            # >= max(clr(P), 0) - dev(P) / 16^levels
+            if has[kj] and max(cj, 0.0) - sv[top] / 16.0 ** (max_depth - depth) - slack >= best_c[kj]:
                 continue
             w = b - a
             n_c = 0
