@@ -14,7 +14,8 @@ Reported per grid step: the median and 90th percentile over the paths of the per
 (best of ``--repeats``), old / new ratios, and the agreement of the two results (same kind,
 feasibility and certification; largest differences of duration and of sampled states at 500
 times). For ``Trajectory.sample``: a single time (the ``state`` call) and the five times of one
-Kanayama control step, old / new.
+Kanayama control step, old / new. Finally the same for the calls the seq-bitstar agent itself
+makes in closed loop (recorded from simulations, then replayed through both implementations).
 
 Usage::
 
@@ -91,6 +92,33 @@ def make_cases(n_random: int) -> list[dict]:
                 cases.append({"name": f"{sc.name}-{i}{'+square' if virtual else ''}",
                               "path": res.path, "spec": spec, "state": state, "obstacles": obs})
     return cases
+
+
+def agent_calls(n_random: int) -> list[tuple[tuple, dict]]:
+    """The plan_motion calls (arguments) of the seq-bitstar agent in closed loop on paper-1..3
+    and ``n_random`` random scenarios, seeds 0 and 1 (recorded by wrapping the function the
+    agent module imported; nothing is changed on disk)."""
+    import anyplan.agents.sequential as seq_agent
+    from anyplan.agents import make_agent
+    from anyplan.simulation import simulate
+
+    calls: list[tuple[tuple, dict]] = []
+    original = seq_agent.plan_motion
+
+    def record(*a, **k):
+        calls.append((a, k))
+        return original(*a, **k)
+
+    seq_agent.plan_motion = record
+    try:
+        scenarios = [load_scenario(n) for n in ("paper-1", "paper-2", "paper-3")]
+        scenarios += [random_scenario(seed) for seed in range(n_random)]
+        for sc in scenarios:
+            for seed in (0, 1):
+                simulate(sc, make_agent("seq-bitstar"), seed=seed)
+    finally:
+        seq_agent.plan_motion = original
+    return calls
 
 
 def best_time(fn, repeats: int) -> float:
@@ -170,6 +198,28 @@ def main() -> None:
                   f"{np.median(a1[:, 1]):.4f}  ratio {np.median(a1[:, 0] / a1[:, 1]):5.1f}")
             print(f"  Trajectory.sample, 5 times [ms]: old {np.median(a5[:, 0]):.4f}  new "
                   f"{np.median(a5[:, 1]):.4f}  ratio {np.median(a5[:, 0] / a5[:, 1]):5.1f}")
+
+        # The calls Sequential BIT* really makes (states on the move, virtual squares, its grid).
+        try:
+            calls = agent_calls(args.random)
+        except Exception as exc:  # the agent is developed concurrently: report, do not fail
+            print(f"\nseq-bitstar calls: skipped ({type(exc).__name__}: {exc})")
+            return
+        t_old, t_new, n_same, dmax = [], [], 0, 0.0
+        for a, k in calls:
+            tr_old, tr_new = old_plan_motion(*a, **k), plan_motion(*a, **k)
+            t_old.append(best_time(partial(old_plan_motion, *a, **k), args.repeats))
+            t_new.append(best_time(partial(plan_motion, *a, **k), args.repeats))
+            same, dd, sd = compare(tr_old, tr_new)
+            n_same += same
+            dmax = max(dmax, dd, sd)
+        to, tn = np.array(t_old) * 1e3, np.array(t_new) * 1e3
+        print(f"\nseq-bitstar's own plan_motion calls ({len(calls)}, closed loop on paper-1..3 and "
+              f"{args.random} random scenarios, seeds 0-1) [ms]")
+        print(f"  old median {np.median(to):7.2f}  p90 {np.percentile(to, 90):7.2f}  max {to.max():7.2f}")
+        print(f"  new median {np.median(tn):7.2f}  p90 {np.percentile(tn, 90):7.2f}  max {tn.max():7.2f}")
+        print(f"  ratio old/new: of medians {np.median(to) / np.median(tn):5.2f}, per call median "
+              f"{np.median(to / tn):5.2f}; same kind/flags {n_same}/{len(calls)}, max difference {dmax:.1e}")
 
 
 if __name__ == "__main__":
