@@ -759,6 +759,42 @@ def brake_eval(tau: np.ndarray, t_end: float, v0: float, w0: float, theta0: floa
 
 
 @njit(cache=True)
+def _argsort_stable(v: np.ndarray) -> np.ndarray:
+    """Indices that sort ``v`` ascending, equal values in their original order (bottom-up
+    merge sort; cheaper to compile than numpy's argsort)."""
+    n = v.shape[0]
+    idx = np.arange(n)
+    tmp = np.empty(n, dtype=np.int64)
+    width = 1
+    while width < n:
+        for lo in range(0, n, 2 * width):
+            mid = min(lo + width, n)
+            hi = min(lo + 2 * width, n)
+            i = lo
+            j = mid
+            q = lo
+            while i < mid and j < hi:
+                if v[idx[j]] < v[idx[i]]:
+                    tmp[q] = idx[j]
+                    j += 1
+                else:
+                    tmp[q] = idx[i]
+                    i += 1
+                q += 1
+            while i < mid:
+                tmp[q] = idx[i]
+                i += 1
+                q += 1
+            while j < hi:
+                tmp[q] = idx[j]
+                j += 1
+                q += 1
+        idx, tmp = tmp, idx
+        width *= 2
+    return idx
+
+
+@njit(cache=True)
 def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarray, limit: float,
                   radius: float, max_depth: int, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray,
                   pbox: np.ndarray, circles: np.ndarray,
@@ -829,7 +865,7 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
     cb = np.empty(4)
     cc = np.empty(4)
     cd = np.empty(4)
-    order = np.argsort(fc[:nf], kind="mergesort")
+    order = _argsort_stable(fc[:nf])
     for r in range(nf):
         j = order[r]
         kj = np.searchsorted(point_u, 0.5 * (fa[j] + fb[j]), side="right") - 1
