@@ -43,20 +43,17 @@ def cubic_spline(x: np.ndarray, y: np.ndarray, mode: int, tan: np.ndarray, nrm: 
     r''(x0) = nrm, natural end, with an extra breakpoint at ``extra`` in (x[0], x[1]).
     """
     n = x.shape[0]
+    off = 1 if mode == 2 else 0
+    npt = n + off
+    xi = np.empty(npt)
+    yi = np.zeros((npt, 2))
+    for j in range(n):
+        q = j + off if j > 0 else 0
+        xi[q] = x[j]
+        yi[q, 0] = y[j, 0]
+        yi[q, 1] = y[j, 1]
     if mode == 2:
-        npt = n + 1
-        xi = np.empty(npt)
-        xi[0] = x[0]
         xi[1] = extra
-        xi[2:] = x[1:]
-        yi = np.empty((npt, 2))
-        yi[0] = y[0]
-        yi[1] = 0.0
-        yi[2:] = y[1:]
-    else:
-        npt = n
-        xi = x.copy()
-        yi = y.copy()
     P = npt - 1
     h = np.empty(P)
     for j in range(P):
@@ -506,8 +503,11 @@ def certify(x: np.ndarray, c: np.ndarray, u: np.ndarray, limit: float, radius: f
     clearance query may stop early once it is known to be below the threshold (minus 1e-9 m,
     far beyond rounding, so pass/fail is exactly that of the exact clearance).
     """
-    a_u = u[:-1].copy()
-    b_u = u[1:].copy()
+    a_u = np.empty(u.shape[0] - 1)
+    b_u = np.empty(u.shape[0] - 1)
+    for j in range(u.shape[0] - 1):
+        a_u[j] = u[j]
+        b_u[j] = u[j + 1]
     margin = np.inf
     fail_u = np.zeros(0)
     fail_c = np.zeros(0)
@@ -647,16 +647,20 @@ def clean_points(p: np.ndarray, tol: float, collinear_tol: float) -> np.ndarray:
     """The loop of ``spline.clean_path`` (p: (N >= 1, 2))."""
     n = p.shape[0]
     keep = np.empty((n, 2))
-    keep[0] = p[0]
+    keep[0, 0] = p[0, 0]
+    keep[0, 1] = p[0, 1]
     nk = 1
     for j in range(1, n):
         if math.hypot(p[j, 0] - keep[nk - 1, 0], p[j, 1] - keep[nk - 1, 1]) > tol:
-            keep[nk] = p[j]
+            keep[nk, 0] = p[j, 0]
+            keep[nk, 1] = p[j, 1]
             nk += 1
     if nk > 1 and math.hypot(p[n - 1, 0] - keep[nk - 1, 0], p[n - 1, 1] - keep[nk - 1, 1]) > 0.0:
-        keep[nk - 1] = p[n - 1]
+        keep[nk - 1, 0] = p[n - 1, 0]
+        keep[nk - 1, 1] = p[n - 1, 1]
     out = np.empty((nk, 2))
-    out[0] = keep[0]
+    out[0, 0] = keep[0, 0]
+    out[0, 1] = keep[0, 1]
     no = 1
     for i in range(1, nk - 1):
         abx = keep[i, 0] - out[no - 1, 0]
@@ -668,12 +672,18 @@ def clean_points(p: np.ndarray, tol: float, collinear_tol: float) -> np.ndarray:
         t = (abx * acx + aby * acy) / max(lac * lac, 1e-300)
         if cross < collinear_tol and 0.0 < t < 1.0:
             continue
-        out[no] = keep[i]
+        out[no, 0] = keep[i, 0]
+        out[no, 1] = keep[i, 1]
         no += 1
     if nk > 1:
-        out[no] = keep[nk - 1]
+        out[no, 0] = keep[nk - 1, 0]
+        out[no, 1] = keep[nk - 1, 1]
         no += 1
-    return out[:no].copy()
+    res = np.empty((no, 2))
+    for j in range(no):
+        res[j, 0] = out[j, 0]
+        res[j, 1] = out[j, 1]
+    return res
 
 
 @njit(cache=True)
@@ -700,7 +710,10 @@ def shortcut_indices(p: np.ndarray, limit: float, vx: np.ndarray, vy: np.ndarray
         keep[nk] = nxt
         nk += 1
         i = nxt
-    return keep[:nk].copy()
+    res = np.empty(nk, dtype=np.int64)
+    for j in range(nk):
+        res[j] = keep[j]
+    return res
 
 
 @njit(cache=True)
@@ -753,8 +766,22 @@ def brake_eval(tau: np.ndarray, t_end: float, v0: float, w0: float, theta0: floa
         out[2, j] = theta0 + w0 * cw - 0.5 * sw * cw * cw
         out[3, j] = v0 - sv * cv
         out[4, j] = w0 - sw * cw
-    out[0] = np.interp(tt, grid, gx)
-    out[1] = np.interp(tt, grid, gy)
+    # linear interpolation of the table, as numpy.interp computes it
+    last = grid.shape[0] - 1
+    for j in range(n):
+        t = tt[j]
+        if t >= grid[last]:
+            out[0, j] = gx[last]
+            out[1, j] = gy[last]
+            continue
+        i = max(np.searchsorted(grid, t, side="right") - 1, 0)
+        if grid[i] == t:
+            out[0, j] = gx[i]
+            out[1, j] = gy[i]
+            continue
+        h = grid[i + 1] - grid[i]
+        out[0, j] = (gx[i + 1] - gx[i]) / h * (t - grid[i]) + gx[i]
+        out[1, j] = (gy[i + 1] - gy[i]) / h * (t - grid[i]) + gy[i]
     return out
 
 
