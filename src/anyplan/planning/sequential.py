@@ -90,8 +90,8 @@ class SequentialConfig:
     """
 
     max_iterations: int = 8
-    first_budget_s: float = 0.02
-    iteration_budget_s: float = 0.005
+    first_budget_s: float = 0.005
+    iteration_budget_s: float = 0.002
     batches_per_plan: int | None = None
     warm_start: bool = False
     margin: float = 0.05
