@@ -162,7 +162,9 @@ def test_straight_line_problem_stops_at_the_optimum():
     planner = BITStar(Problem.create(obs, (1.0, 2.0), (9.0, 2.0), 0.3), rng=0)
     planner.solve(batches(1000))  # returns early: the straight line cannot be beaten
     assert planner.best_cost == pytest.approx(8.0)
-    assert planner.n_batches < 1000
+    assert planner.n_batches == 0  # tried before any sampling
+    assert planner.result().first_solution_time_s is not None
+    assert np.array_equal(planner.result().path, [[1.0, 2.0], [9.0, 2.0]])
 
 
 def test_add_obstacles_invalidates_only_what_they_block_and_reuses_work():

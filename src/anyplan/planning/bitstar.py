@@ -449,6 +449,8 @@ class BITStar(Planner):
         obs_args = self._obs.kernel_args
         t0 = time.perf_counter()
         clock_base = self._solve_time - t0
+        if self.n_batches == 0 and not math.isfinite(self.best_cost):
+            self._try_direct_edge(clock_base)
         cfg = self.config
         c_min = self._c_min
         while not ptc():
@@ -484,6 +486,29 @@ class BITStar(Planner):
                     self.callback(t, cost, self._path.copy())
         self._solve_time = time.perf_counter() + clock_base
         return self._status()
+
+    def _try_direct_edge(self, clock_base: float) -> None:
+        """Before the first batch: if the straight start-goal motion is free, it is optimal."""
+        p = self.problem
+        if not p.obstacles.segment_free(p.start, p.goal, p.check_radius):
+            return
+        self._F[1, core.G_T] = self._c_min
+        it = self._I
+        it[1, core.PAR] = 0
+        it[1, core.PSIB] = -1
+        it[1, core.NSIB] = it[0, core.FCHILD]
+        if it[0, core.FCHILD] >= 0:
+            it[it[0, core.FCHILD], core.PSIB] = 1
+        it[0, core.FCHILD] = 1
+        it[1, core.FLAGS] = core.F_VERTEX
+        self._N[core.N_CHECKS] += 1
+        self._S[core.S_CBEST] = self._c_min
+        t = time.perf_counter() + clock_base
+        self._first_time = t
+        self._history.append((t, self._c_min))
+        self._path = self._extract_path()
+        if self.callback is not None:
+            self.callback(t, self._c_min, self._path.copy())
 
     def result(self) -> PlanResult:
         """The best path so far, with timing and the cost history."""
