@@ -35,7 +35,7 @@ from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import SequentialBITStar, SequentialConfig, SequentialResult
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
 from anyplan.prediction.collision import first_collision
-from anyplan.trajectory.motion import plan_motion
+from anyplan.trajectory.motion import brake_to_rest, continue_from, plan_motion
 from anyplan.trajectory.trajectory import BrakeSegment, Segment, Trajectory
 from anyplan.world.robot import Command, RobotState
 from anyplan.world.scenario import Scenario
@@ -147,20 +147,17 @@ class SequentialBITStarAgent(Agent):
             obst = self.obstacles.with_shapes(shapes) if shapes else self.obstacles
             if delay <= 0.0:
                 return plan_motion(path, spec, state, obst, t_start, margin=margin, grid_step=self.grid_step)
-            segs: list[Segment] = []
-            t, x, y, th = t_start, state.x, state.y, state.theta
-            if abs(state.v) > 1e-6 or abs(state.omega) > 1e-6:
-                brake = BrakeSegment(x, y, th, state.v, state.omega, spec.a_max, spec.alpha_max, t)
-                segs.append(brake)
-                t = brake.t1
-                bx, by, bth, _, _ = brake.sample(np.array([t]))
-                x, y, th = float(bx[0]), float(by[0]), float(bth[0])
-            segs.append(HoldSegment(x, y, th, t, t + delay))
-            rest = RobotState(x, y, th, 0.0, 0.0)
-            p = np.asarray(path, dtype=float)
-            here = np.array([x, y])
-            if len(p) >= 2 and obst.segment_free(here, p[1], spec.radius + margin):
-                p = np.vstack([here, p[1:]])
+            segs, t, rest, _ = brake_to_rest(state, spec, obst, spec.radius + margin, t_start)
+            if abs(rest.omega) > 1e-9:  # turning in place: stop the rotation at alpha_max too
+                stop = BrakeSegment(rest.x, rest.y, rest.theta, 0.0, rest.omega, spec.a_max,
+                                    spec.alpha_max, t)
+                segs.append(stop)
+                t = stop.t1
+                rest = RobotState(*(float(v[0]) for v in stop.sample(np.array([t]))))
+            segs.append(HoldSegment(rest.x, rest.y, rest.theta, t, t + delay))
+            rest = RobotState(rest.x, rest.y, rest.theta, 0.0, 0.0)
+            p = continue_from(np.array([rest.x, rest.y]), np.asarray(path, dtype=float), obst,
+                              spec.radius + margin)
             tail = plan_motion(p, spec, rest, obst, t + delay, margin=margin, grid_step=self.grid_step)
             return Trajectory(segs + tail.segments, kind="wait+" + tail.kind, feasible=tail.feasible,
                               lower_bound_s=tail.lower_bound_s, polyline=tail.polyline,

@@ -36,7 +36,7 @@ from anyplan.trajectory.trajectory import (
 from anyplan.trajectory.turn import rotation_profile
 from anyplan.world.robot import RobotSpec, RobotState
 
-__all__ = ["plan_motion", "turn_segment", "polyline_trajectory"]
+__all__ = ["plan_motion", "turn_segment", "polyline_trajectory", "brake_to_rest", "continue_from"]
 
 _EPS_V = 1e-6  # [m/s] speeds below this count as rest
 _EPS_TH = 1e-3  # [rad] headings closer than this count as aligned
@@ -67,8 +67,23 @@ def _brake(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: f
     return seg, free
 
 
-def _continue_from(p_stop: np.ndarray, pts: np.ndarray, obstacles: ObstacleSet,
-                   radius: float) -> np.ndarray:
+def brake_to_rest(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: float,
+                  t0: float) -> tuple[list[Segment], float, RobotState, bool]:
+    """Brake to rest from ``state`` at ``t0`` [s] (nothing to do at rest).
+
+    Returns:
+        The segments (the braking segment, or none), the time [s] the robot is at rest, its
+        state at rest, and whether the braking path is certified free for ``radius``.
+    """
+    brake, free = _brake(state, spec, obstacles, radius, t0)
+    if brake is None:
+        return [], t0, RobotState(state.x, state.y, state.theta, 0.0, state.omega), free
+    bx, by, bth, _, _ = brake.sample(np.array([brake.t1]))
+    return [brake], brake.t1, RobotState(float(bx[0]), float(by[0]), float(bth[0]), 0.0, 0.0), free
+
+
+def continue_from(p_stop: np.ndarray, pts: np.ndarray, obstacles: ObstacleSet,
+                  radius: float) -> np.ndarray:
     """The path from ``p_stop`` (where the robot will be at rest): skip pts[0] if possible."""
     if len(pts) >= 2 and obstacles.segment_free(p_stop, pts[1], radius) and \
             math.hypot(*(pts[1] - p_stop)) > 1e-6:
@@ -83,24 +98,16 @@ def polyline_trajectory(path: np.ndarray, spec: RobotSpec, state: RobotState, t_
                         grid_step: float = 0.02) -> Trajectory:
     """Brake if moving, then turn in place and drive straight, rest to rest, along each segment.
 
-    The path continues from where the robot stops (see ``_continue_from``). The result's
+    The path continues from where the robot stops (see ``continue_from``). The result's
     ``certified_free`` tells whether the braking path and every segment are free for ``radius``
     (default: the robot radius) among ``obstacles``.
     """
     r = spec.radius if radius is None else radius
     obst = obstacles if obstacles is not None else ObstacleSet()
-    segs: list[Segment] = []
-    t = t_start
-    brake, free = _brake(state, spec, obst, r, t)
-    x, y, th, w = state.x, state.y, state.theta, state.omega
-    if brake is not None:
-        segs.append(brake)
-        t = brake.t1
-        bx, by, bth, _, _ = brake.sample(np.array([t]))
-        x, y, th = float(bx[0]), float(by[0]), float(bth[0])
-        w = 0.0
+    segs, t, rest, free = brake_to_rest(state, spec, obst, r, t_start)
+    x, y, th, w = rest.x, rest.y, rest.theta, rest.omega
     pts = clean_path(path)
-    pts = _continue_from(np.array([x, y]), pts, obst, r) if len(pts) >= 2 else np.array([[x, y]])
+    pts = continue_from(np.array([x, y]), pts, obst, r) if len(pts) >= 2 else np.array([[x, y]])
     free = free and obst.path_free(pts, r)
     length = 0.0
     for a, b in zip(pts[:-1], pts[1:], strict=True):
@@ -219,16 +226,10 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
     misaligned = abs(float(wrap_angle(first_dir - state.theta))) > _EPS_TH
     turning = abs(state.omega) > 1e-3
     if allow_turn and (misaligned or turning or res.curve is None or not cands[-1][0]):
-        segs: list[Segment] = []
-        t = t_start
-        brake, brake_free = _brake(state, spec, obstacles, radius, t)
-        x, y, th, w = state.x, state.y, state.theta, state.omega
-        if brake is not None:
-            segs.append(brake)
-            t = brake.t1
-            bx, by, bth, _, _ = brake.sample(np.array([t]))
-            x, y, th, w = float(bx[0]), float(by[0]), float(bth[0]), 0.0
-        pts_b = _continue_from(np.array([x, y]), pts, obstacles, radius)
+        segs, t, rest, brake_free = brake_to_rest(state, spec, obstacles, radius, t_start)
+        braked = bool(segs)
+        x, y, th, w = rest.x, rest.y, rest.theta, rest.omega
+        pts_b = continue_from(np.array([x, y]), pts, obstacles, radius)
         target = math.atan2(pts_b[1][1] - pts_b[0][1], pts_b[1][0] - pts_b[0][0])
         turn = turn_segment(x, y, th, target, spec, t, w)
         if turn.t1 > turn.t0:
@@ -239,7 +240,7 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         if res_b.curve is not None and brake_free:
             prof = time_parameterize(res_b.curve, spec, 0.0)
             segs.append(CurveSegment(res_b.curve, prof, t))
-            tr = Trajectory(segs, kind="turn+smooth" if brake is None else "brake+turn+smooth",
+            tr = Trajectory(segs, kind="brake+turn+smooth" if braked else "turn+smooth",
                             feasible=True,
                             lower_bound_s=time_lower_bound(res_b.curve.length, spec, 0.0),
                             polyline=pts_b,
