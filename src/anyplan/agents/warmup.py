@@ -47,6 +47,20 @@ def warm_up_kernels() -> float:
         traj.sample(np.linspace(0.0, traj.t_end, 7))
     mover = PredictedObstacle("D", 0.2, UnicycleMotion(3.0, 0.5, 2.0, 0.2, 0.1))
     first_collision(traj, [mover], spec.radius, sample_dt=0.02)
+    # One Sequential BIT* replanning around a crossing obstacle: virtual squares, repairs of
+    # curves that cut them, delayed departures.
+    from anyplan.planning.sequential import SequentialBITStar, SequentialConfig
+
+    crossing = PredictedObstacle("X", 0.2, UnicycleMotion(2.0, 0.2, 1.5708, 0.25, 0.0))
+    rest = RobotState(0.5, 3.0, -0.7854)
+
+    def motion_fn(p: np.ndarray, shapes: list, delay: float):  # noqa: ANN202
+        return plan_motion(p, spec, rest, obs.with_shapes(shapes), delay, margin=0.015, grid_step=0.05)
+
+    loop = SequentialBITStar(obs, spec.radius, spec.radius + 0.03, motion_fn,
+                             SequentialConfig(max_iterations=3, wait_delays_s=(1.0,)),
+                             np.random.default_rng(0))
+    loop.replan(np.array([0.5, 3.0]), np.array([3.5, 0.5]), [crossing], 0.0)
     dt = time.perf_counter() - t0
     logger.info("compiled kernels ready in %.2f s", dt)
     return dt
