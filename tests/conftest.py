@@ -6,6 +6,12 @@ import os
 
 import numpy as np
 import pytest
+from hypothesis import settings
+
+# CI replays the same examples on every run (derandomised); locally each run explores new ones.
+settings.register_profile("ci", derandomize=True, print_blob=True)
+if os.environ.get("CI"):
+    settings.load_profile("ci")
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
