@@ -118,8 +118,7 @@ class SequentialBITStarAgent(Agent):
         self.rng = rng
         self.predictor = ConstantTwistPredictor()
         self.loop = SequentialBITStar(self.obstacles, self.spec.radius,
-                                      self.spec.radius + self.plan_margin, self._motion_unused,
-                                      self.config, rng)
+                                      self.spec.radius + self.plan_margin, None, self.config, rng)
         self.controller = KanayamaController(self.spec, self.gains, 0.05)
         self.trajectory: Trajectory | None = None
         self.pending: tuple[float, Trajectory] | None = None
@@ -132,10 +131,6 @@ class SequentialBITStarAgent(Agent):
         ex = self.stats.extra
         ex.update({"statuses": {}, "iterations": [], "late_plans": 0, "plan_time_s": [],
                    "motion_time_s": [], "replan_times_s": [], "waits": 0})
-
-    @staticmethod
-    def _motion_unused(path: np.ndarray, shapes: Any, delay: float) -> Trajectory:
-        raise RuntimeError("motion_fn is bound per replanning")
 
     # --- motions ---------------------------------------------------------------------------------
     def _motion_fn(self, state: RobotState, t_start: float):  # noqa: ANN202
@@ -190,10 +185,10 @@ class SequentialBITStarAgent(Agent):
         d = self._expected_delay(dt)
         t_ready = t + d
         state = self._state_at(obs, t_ready)
-        self.loop.motion_fn = self._motion_fn(state, t_ready)
         w0 = time.perf_counter()
         res: SequentialResult = self.loop.replan(np.array([state.x, state.y]),
-                                                 np.asarray(self.spec.goal, dtype=float), preds, t)
+                                                 np.asarray(self.spec.goal, dtype=float), preds, t,
+                                                 self._motion_fn(state, t_ready))
         wall = time.perf_counter() - w0
         self._last_replan = t
         st = self.stats

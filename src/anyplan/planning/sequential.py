@@ -232,13 +232,15 @@ class SequentialBITStar:
         obstacles: Static obstacles with the arena walls.
         robot_radius: [m].
         plan_radius: Radius [m] BIT* plans for (robot radius plus a planning margin).
-        motion_fn: Builds the timed motion along a path (see :data:`MotionFn`).
+        motion_fn: Builds the timed motion along a path (see :data:`MotionFn`); may instead be
+            given to each :meth:`replan` (it usually depends on the state the motion starts
+            from).
         config: Loop settings.
         rng: Random generator of BIT*.
     """
 
     def __init__(self, obstacles: ObstacleSet, robot_radius: float, plan_radius: float,
-                 motion_fn: MotionFn, config: SequentialConfig | None = None,
+                 motion_fn: MotionFn | None = None, config: SequentialConfig | None = None,
                  rng: np.random.Generator | None = None) -> None:
         self.obstacles = obstacles
         self.robot_radius = float(robot_radius)
@@ -257,7 +259,7 @@ class SequentialBITStar:
         return any_of(timed(budget) & first_solution(), timed(20.0 * budget))
 
     def replan(self, start: np.ndarray, goal: np.ndarray, predictions: Sequence[PredictedObstacle],
-               t_now: float) -> SequentialResult:
+               t_now: float, motion_fn: MotionFn | None = None) -> SequentialResult:
         """Plan from ``start`` to ``goal`` until the predicted motion is collision-free.
 
         Args:
@@ -265,7 +267,11 @@ class SequentialBITStar:
             goal: Goal (x, y) [m].
             predictions: Predicted moving obstacles (absolute times).
             t_now: Time [s] stamped on the virtual obstacles created.
+            motion_fn: The motion model for this replanning (default: the constructor's).
         """
+        motion_fn = motion_fn or self.motion_fn
+        if motion_fn is None:
+            raise ValueError("motion_fn: give one to the constructor or to replan")
         cfg = self.config
         start = np.asarray(start, dtype=float)
         goal = np.asarray(goal, dtype=float)
@@ -303,7 +309,7 @@ class SequentialBITStar:
                 history = list(res.history)
             t1 = time.perf_counter()
             shapes = [s.shape for s in squares]
-            motion = self.motion_fn(res.path, shapes, 0.0)
+            motion = motion_fn(res.path, shapes, 0.0)
             hit = first_collision(motion, predictions, self.robot_radius, margin=cfg.margin,
                                   sample_dt=cfg.prediction_dt)
             motion_time += time.perf_counter() - t1
@@ -325,7 +331,8 @@ class SequentialBITStar:
                 planner.add_obstacles([vo.shape])
         # Algorithm 1 did not converge: try waiting before departing on the paths found.
         t1 = time.perf_counter()
-        waited = self._try_waiting(candidates, predictions, time.perf_counter() + cfg.max_time_s)
+        waited = self._try_waiting(candidates, predictions, motion_fn,
+                                   time.perf_counter() + cfg.max_time_s)
         motion_time += time.perf_counter() - t1
         if waited is not None:
             path, shapes, delay, motion = waited
@@ -361,7 +368,7 @@ class SequentialBITStar:
                                s < side)
 
     def _try_waiting(self, candidates: list[tuple[np.ndarray, list[Shape]]],
-                     predictions: Sequence[PredictedObstacle], deadline: float
+                     predictions: Sequence[PredictedObstacle], motion_fn: MotionFn, deadline: float
                      ) -> tuple[np.ndarray, list[Shape], float, TimedMotion] | None:
         if not candidates:
             return None
@@ -372,7 +379,7 @@ class SequentialBITStar:
                 if time.perf_counter() > deadline:
                     return None
                 path, shapes = candidates[i]
-                motion = self.motion_fn(path, shapes, delay)
+                motion = motion_fn(path, shapes, delay)
                 if first_collision(motion, predictions, self.robot_radius, margin=self.config.margin,
                                    sample_dt=self.config.prediction_dt) is None:
                     return path, shapes, delay, motion

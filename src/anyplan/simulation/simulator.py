@@ -191,7 +191,7 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
         step_clear = c_static
         hit = None
         if c_static < -COLLISION_EPS:
-            hit = _nearest_static_name(scenario, a, b)
+            hit = scenario.nearest_static(a, b)
         if movers:
             p_new = np.array([o.position(t_new) for o in movers])
             for j, o in enumerate(movers):
@@ -239,15 +239,3 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
         wall_time_s=time.perf_counter() - wall0,
         extra=dict(st.extra),
     )
-
-
-def _nearest_static_name(scenario: Scenario, a: np.ndarray, b: np.ndarray) -> str:
-    from anyplan.geometry.collision import ObstacleSet
-
-    best, name = math.inf, "wall"
-    for o in scenario.static_obstacles:
-        d = ObstacleSet([o.shape]).segment_clearance(a, b)
-        if d < best:
-            best, name = d, o.name
-    walls = ObstacleSet([], bounds=scenario.bounds).segment_clearance(a, b)
-    return "wall" if walls < best else name

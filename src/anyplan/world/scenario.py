@@ -83,6 +83,20 @@ class Scenario:
         """The static obstacles and the arena walls, for exact clearance queries."""
         return ObstacleSet([o.shape for o in self.static_obstacles], bounds=self.bounds)
 
+    def nearest_static(self, a: Sequence[float] | np.ndarray,
+                       b: Sequence[float] | np.ndarray | None = None) -> str:
+        """Name of the static obstacle nearest to point ``a`` (or to segment ``a``-``b``), or
+        ``"wall"`` when the arena walls are nearer; for naming what a collision hit."""
+        def dist(obs: ObstacleSet) -> float:
+            return obs.clearance(a) if b is None else obs.segment_clearance(a, b)
+
+        best, name = dist(ObstacleSet([], bounds=self.bounds)), "wall"
+        for o in self.static_obstacles:
+            d = dist(ObstacleSet([o.shape]))
+            if d < best:
+                best, name = d, o.name
+        return name
+
     def static_only(self) -> Scenario:
         """The same scenario without its moving obstacles (what a static planner knows)."""
         return replace(self, moving_obstacles=())
@@ -338,18 +352,9 @@ def _check_task(c: _Ctx, sc: Scenario) -> None:
             raise c.fail(fld, f"({x:g}, {y:g}) is outside the arena [0, {sc.width:g}] x "
                               f"[0, {sc.height:g}] shrunk by the robot radius {r:g}")
         if obs.clearance(p) < r - COLLISION_EPS:
-            hit = _nearest_static(sc, p)
+            hit = sc.nearest_static(p)
             raise c.fail(fld, f"({x:g}, {y:g}) is inside static obstacle {hit} inflated by the "
                               f"robot radius {r:g}")
-
-
-def _nearest_static(sc: Scenario, p: Sequence[float]) -> str:
-    best, name = math.inf, "?"
-    for o in sc.static_obstacles:
-        d = ObstacleSet([o.shape]).clearance(p)
-        if d < best:
-            best, name = d, o.name
-    return name
 
 
 # --------------------------------------------------------------------------------------------
