@@ -88,6 +88,13 @@ def heap_pop(keys: np.ndarray, pay: np.ndarray, size: int) -> int:
 
 
 # --- grid -------------------------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _cell_of(x: float, y: float, x0: float, y0: float, cell: float, ncx: int,
+             ncy: int) -> tuple[int, int]:
+    """Grid cell (column, row) of the point (x, y), clamped to the grid."""
+    return (min(max(int((x - x0) / cell), 0), ncx - 1), min(max(int((y - y0) / cell), 0), ncy - 1))
+
+
 @njit(cache=True)
 def build_grid(P: np.ndarray, idx: np.ndarray, x0: float, y0: float, cell: float, ncx: int,
                ncy: int) -> tuple[np.ndarray, np.ndarray]:
@@ -97,8 +104,7 @@ def build_grid(P: np.ndarray, idx: np.ndarray, x0: float, y0: float, cell: float
     cid = np.empty(n, np.int64)
     for t in range(n):
         i = idx[t]
-        cx = min(max(int((P[i, 0] - x0) / cell), 0), ncx - 1)
-        cy = min(max(int((P[i, 1] - y0) / cell), 0), ncy - 1)
+        cx, cy = _cell_of(P[i, 0], P[i, 1], x0, y0, cell, ncx, ncy)
         cid[t] = cy * ncx + cx
         cstart[cid[t] + 1] += 1
     for c in range(ncx * ncy):
@@ -125,8 +131,7 @@ def _near(v: int, P: np.ndarray, rad: float, cstart: np.ndarray, citems: np.ndar
     ncy = N[N_NCY]
     px = P[v, 0]
     py = P[v, 1]
-    cx = min(max(int((px - x0) / cell), 0), ncx - 1)
-    cy = min(max(int((py - y0) / cell), 0), ncy - 1)
+    cx, cy = _cell_of(px, py, x0, y0, cell, ncx, ncy)
     r2 = rad * rad
     m = 0
     for yy in range(max(cy - 1, 0), min(cy + 2, ncy)):
@@ -161,8 +166,7 @@ def _k_nearest(v: int, P: np.ndarray, k: int, cstart: np.ndarray, citems: np.nda
     ncy = N[N_NCY]
     px = P[v, 0]
     py = P[v, 1]
-    cx = min(max(int((px - x0) / cell), 0), ncx - 1)
-    cy = min(max(int((py - y0) / cell), 0), ncy - 1)
+    cx, cy = _cell_of(px, py, x0, y0, cell, ncx, ncy)
     ring = 1
     n_total = N[N_N] - 1
     kk = min(k, n_total)
