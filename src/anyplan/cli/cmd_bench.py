@@ -128,9 +128,17 @@ def cmd_bench(args: argparse.Namespace) -> int:
     cmp = format_paper_comparison(ptables)
     if cmp:
         print("\n" + cmp)
+    from anyplan.experiments.barn_tables import bench_barn_report
+
+    barn = bench_barn_report(args.suite, runs)  # a folder written by 'anyplan import-barn'
+    if barn:
+        print("\n" + barn[0])
     if args.out:
         try:
             paths = write_tables(tables, args.out, ptables)
+            if barn:
+                paths.append(Path(args.out) / "barn.md")
+                paths[-1].write_text(barn[1])
         except OSError as exc:
             raise _usage(f"bench: --out {args.out}: cannot write ({exc.strerror})") from None
         print("\nwrote " + ", ".join(str(p) for p in paths))

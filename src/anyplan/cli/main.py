@@ -25,6 +25,7 @@ COMMAND_MODULES = [
     "anyplan.cli.cmd_run",
     "anyplan.cli.cmd_bench",
     "anyplan.cli.cmd_dynabarn",
+    "anyplan.cli.cmd_barn",
     "anyplan.cli.cmd_plan",
     "anyplan.cli.cmd_dovs",
 ]

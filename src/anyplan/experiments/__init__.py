@@ -6,6 +6,8 @@
 * :mod:`~anyplan.experiments.db`: :class:`ResultsDB`, an SQLite file in OMPL's benchmark layout.
 * :mod:`~anyplan.experiments.tables`: the paper's Tables 2-3 from the database.
 * :mod:`~anyplan.experiments.dynabarn`: DynaBARN worlds as scenario files.
+* :mod:`~anyplan.experiments.barn`, :mod:`~anyplan.experiments.barn_tables`: BARN's static worlds
+  as scenario files, their feasibility, and the BARN table.
 """
 
 from anyplan.experiments.db import ResultsDB
