@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from anyplan.prediction.base import ObstacleObservation
+from anyplan.prediction.detection import Detection
 from anyplan.registry import Registry
 from anyplan.world.robot import Command, RobotState
 from anyplan.world.scenario import Scenario
@@ -25,12 +26,15 @@ class Observation:
         t: Simulation time [s].
         robot: The robot's pose and twist.
         obstacles: Moving obstacles currently observed (all of them, or only those within
-            ``robot.sensing_range``).
+            ``robot.sensing_range``), with pose and twist (``oracle`` and ``twist`` perception).
+        detections: Noisy positions of the obstacles detected at this step (``tracked``
+            perception, only on sensor frames; see :mod:`anyplan.simulation.perception`).
     """
 
     t: float
     robot: RobotState
     obstacles: tuple[ObstacleObservation, ...] = ()
+    detections: tuple[Detection, ...] = ()
 
 
 @dataclass

@@ -46,6 +46,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--time-limit", type=float, default=None,
                    help="simulated time limit [s] (default: each scenario's)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    from anyplan.cli.perception_opts import add_perception_options
+
+    add_perception_options(p)
     p.set_defaults(func=cmd_bench)
 
     q = sub.add_parser("bench-planning", help="anytime planning benchmark: our BIT* beside OMPL",
@@ -101,6 +104,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
     planners = parse_planners(args.planners, args.config)
     scenarios = resolve_suite(args.suite, random_seed=args.seed if args.random_seed is None
                               else args.random_seed, per_count=args.random_count)
+    from anyplan.cli.perception_opts import apply_perception
+
+    scenarios = apply_perception("bench", scenarios, args)
     db_path = Path(args.db)
     if db_path.parent and not db_path.parent.exists():
         raise _usage(f"bench: --db {db_path}: folder {db_path.parent} does not exist")

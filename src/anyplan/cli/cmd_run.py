@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from anyplan.agents.base import AGENTS, make_agent
+from anyplan.cli.perception_opts import add_perception_options, apply_perception
 from anyplan.simulation.simulator import SimConfig, simulate
 from anyplan.world.scenario import builtin_scenarios, load_scenario
 
@@ -31,6 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="also write an animation of the run (.gif, or .mp4 when ffmpeg is present)")
     p.add_argument("--speed", type=float, default=4.0,
                    help="animation playback speed, x real time (default 4)")
+    add_perception_options(p)
     p.set_defaults(func=cmd_run)
 
     s = sub.add_parser("scenarios", help="list the built-in scenarios")
@@ -48,7 +50,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     """Simulate one run and write its result and picture."""
     from anyplan.cli.main import UsageError
 
-    scenario = load_scenario(args.scenario)
+    scenario = apply_perception("run", [load_scenario(args.scenario)], args)[0]
     AGENTS.get(args.planner)  # unknown names fail here, before any work
     try:
         cfg = SimConfig(dt=args.dt, time_limit=args.time_limit)

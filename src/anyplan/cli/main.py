@@ -26,6 +26,7 @@ COMMAND_MODULES = [
     "anyplan.cli.cmd_bench",
     "anyplan.cli.cmd_dynabarn",
     "anyplan.cli.cmd_barn",
+    "anyplan.cli.cmd_crowd",
     "anyplan.cli.cmd_plan",
     "anyplan.cli.cmd_dovs",
 ]

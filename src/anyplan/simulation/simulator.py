@@ -29,6 +29,7 @@ from anyplan.agents.base import Agent, Observation
 from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.geometry.moving import closest_approach_straight
 from anyplan.prediction.base import ObstacleObservation
+from anyplan.simulation.perception import Sensor, effective_sensing, observe_exact
 from anyplan.world.robot import RobotState, step
 from anyplan.world.scenario import Scenario
 
@@ -46,7 +47,9 @@ class SimConfig:
         announce_motions: Observations carry each visible obstacle's motion model (the paper's
             assumption: the obstacles' motion is known). Off, agents get only the current pose
             and twist and must extrapolate (a constant twist is then wrong at the corners of a
-            waypoint track and before a ``start_time``).
+            waypoint track and before a ``start_time``). Off turns a scenario's ``oracle``
+            sensing into ``twist``; the scenario's ``sensing:`` block chooses the mode otherwise
+            (:mod:`anyplan.simulation.perception`).
     """
 
     dt: float = 0.05
@@ -121,16 +124,9 @@ def _jsonable(obj: Any) -> Any:
 def observe(scenario: Scenario, t: float, robot: RobotState,
             announce: bool = True) -> tuple[ObstacleObservation, ...]:
     """The moving obstacles visible at time ``t`` [s] (within the sensing range, if any); with
-    ``announce`` each observation carries the obstacle's motion model."""
-    rng_limit = scenario.robot.sensing_range
-    out = []
-    for o in scenario.moving_obstacles:
-        x, y, th, v, w = o.motion.state(t)
-        if rng_limit is not None and math.hypot(x - robot.x, y - robot.y) > rng_limit:
-            continue
-        out.append(ObstacleObservation(o.name, t, x, y, th, v, w, o.radius,
-                                       o.motion if announce else None))
-    return tuple(out)
+    ``announce`` each observation carries the obstacle's motion model
+    (:func:`anyplan.simulation.perception.observe_exact`)."""
+    return observe_exact(scenario, t, robot, announce)
 
 
 def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
@@ -152,6 +148,7 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
     obstacles = scenario.obstacle_set()
     movers = scenario.moving_obstacles
     wall0 = time.perf_counter()
+    sensor = Sensor(scenario, effective_sensing(scenario, cfg.announce_motions), seed)
     agent.reset(scenario.static_only(), np.random.default_rng(seed))
 
     state = RobotState(*spec.start, 0.0, 0.0)
@@ -169,7 +166,9 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
         p_obs = np.array([o.position(0.0) for o in movers])
         radii = np.array([o.radius for o in movers])
         d0 = np.hypot(p_obs[:, 0] - state.x, p_obs[:, 1] - state.y) - radii - r
-        min_clear = min(min_clear, float(d0.min()))
+        alive0 = [o.motion.exists(0.0) for o in movers]
+        if any(alive0):
+            min_clear = min(min_clear, float(d0[alive0].min()))
     else:
         p_obs = np.zeros((0, 2))
         radii = np.zeros(0)
@@ -179,7 +178,8 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
             reached = True
             time_to_goal = t
             break
-        obs = Observation(t, state, observe(scenario, t, state, cfg.announce_motions))
+        seen, detections = sensor.observe(t, state)
+        obs = Observation(t, state, seen, detections)
         cmd = agent.act(obs)
         new = step(spec, state, cmd, dt)
         t_new = (i + 1) * dt
@@ -195,8 +195,12 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
         if movers:
             p_new = np.array([o.position(t_new) for o in movers])
             for j, o in enumerate(movers):
+                lo, hi = o.motion.span  # a recorded track exists only within its span
+                s0, s1 = max(t, lo) - t, min(t_new, hi) - t
+                if s1 < s0:
+                    continue
                 _, d = closest_approach_straight(a, (b - a) / dt, p_obs[j], (p_new[j] - p_obs[j]) / dt,
-                                                 0.0, dt)
+                                                 s0, s1)
                 c = d - r - radii[j]
                 if c < step_clear:
                     step_clear = c
@@ -237,5 +241,5 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
         scenario_hash=scenario.content_hash(),
         dt_s=dt,
         wall_time_s=time.perf_counter() - wall0,
-        extra=dict(st.extra),
+        extra={**st.extra, "perception": sensor.record()},
     )

@@ -8,6 +8,8 @@ A moving obstacle follows its motion whatever is in its way (it is not reactive)
   ``(x0 + v/w (sin(th0 + w t) - sin th0), y0 - v/w (cos(th0 + w t) - cos th0))``.
   Before ``start_time`` the obstacle waits at its start pose; ``t`` above is measured from it.
 * :class:`WaypointMotion`: a looping, time-stamped, piecewise-linear track (DynaBARN).
+* :class:`TrackMotion`: a recorded, time-stamped track (e.g. a pedestrian), not looping, linear
+  in between; the obstacle exists only between its first and last sample (:attr:`Motion.span`).
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Motion", "UnicycleMotion", "WaypointMotion"]
+__all__ = ["Motion", "UnicycleMotion", "WaypointMotion", "TrackMotion"]
 
 
 class Motion:
@@ -25,6 +27,13 @@ class Motion:
 
     #: Upper bound on the speed [m/s], used by certified contact tests.
     max_speed: float = 0.0
+    #: Times [s] between which the obstacle exists (outside, it is neither an obstacle nor
+    #: observed); every motion but :class:`TrackMotion` exists at all times.
+    span: tuple[float, float] = (-math.inf, math.inf)
+
+    def exists(self, t: float) -> bool:
+        """True if the obstacle exists at time ``t`` [s]."""
+        return self.span[0] <= t <= self.span[1]
 
     def positions(self, t: np.ndarray) -> np.ndarray:
         """Positions at times ``t`` (N,) [s], shape (N, 2) [m]."""
@@ -130,4 +139,48 @@ class WaypointMotion(Motion):
         vx = (k[i + 1, 1] - k[i, 1]) / dt
         vy = (k[i + 1, 2] - k[i, 2]) / dt
         x, y = self.position(t)
+        return float(x), float(y), math.atan2(vy, vx), math.hypot(vx, vy), 0.0
+
+
+@dataclass(frozen=True)
+class TrackMotion(Motion):
+    """A recorded track: ``samples`` rows (t [s], x [m], y [m]), times strictly increasing.
+
+    Not looping: the position is the linear interpolation of the samples, exact at every sample;
+    the obstacle exists only on ``[t_first, t_last]`` (:attr:`span`). Outside the span
+    :meth:`positions` returns the first or last sample (callers test :meth:`exists`).
+    """
+
+    samples: np.ndarray
+
+    def __post_init__(self) -> None:
+        k = np.asarray(self.samples, dtype=float)
+        if k.ndim != 2 or k.shape[1] != 3 or len(k) < 2:
+            raise ValueError("samples must have shape (N >= 2, 3) as rows (t, x, y)")
+        if np.any(np.diff(k[:, 0]) <= 0.0):
+            raise ValueError("sample times must increase strictly")
+        k.setflags(write=False)
+        object.__setattr__(self, "samples", k)
+        object.__setattr__(self, "span", (float(k[0, 0]), float(k[-1, 0])))
+
+    @property
+    def max_speed(self) -> float:  # type: ignore[override]
+        k = self.samples
+        seg = np.hypot(np.diff(k[:, 1]), np.diff(k[:, 2])) / np.diff(k[:, 0])
+        return float(seg.max())
+
+    def positions(self, t: np.ndarray) -> np.ndarray:
+        tt = np.asarray(t, dtype=float)
+        k = self.samples
+        return np.column_stack([np.interp(tt, k[:, 0], k[:, 1]), np.interp(tt, k[:, 0], k[:, 2])])
+
+    def state(self, t: float) -> tuple[float, float, float, float, float]:
+        k = self.samples
+        i = int(np.clip(np.searchsorted(k[:, 0], t, side="right") - 1, 0, len(k) - 2))
+        dt = k[i + 1, 0] - k[i, 0]
+        vx = (k[i + 1, 1] - k[i, 1]) / dt
+        vy = (k[i + 1, 2] - k[i, 2]) / dt
+        x, y = self.position(t)
+        if not self.span[0] <= t < self.span[1]:
+            return float(x), float(y), math.atan2(vy, vx), 0.0, 0.0
         return float(x), float(y), math.atan2(vy, vx), math.hypot(vx, vy), 0.0

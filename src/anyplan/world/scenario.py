@@ -24,8 +24,9 @@ import yaml
 from anyplan.errors import ScenarioError, UnknownNameError
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.geometry.shapes import Circle, Polygon, Shape, rectangle
-from anyplan.world.motion import Motion, UnicycleMotion, WaypointMotion
+from anyplan.world.motion import Motion, TrackMotion, UnicycleMotion, WaypointMotion
 from anyplan.world.robot import RobotSpec
+from anyplan.world.sensing import SensingSpec
 
 __all__ = [
     "StaticObstacle",
@@ -73,6 +74,8 @@ class Scenario:
     description: str = ""
     time_limit: float = 120.0
     source: str = "<dict>"
+    #: Perception settings (``sensing:``); None = no block = ``oracle``.
+    sensing: SensingSpec | None = None
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
@@ -119,6 +122,8 @@ class Scenario:
         out["robot"] = robot
         out["static_obstacles"] = [dict(o.spec) for o in self.static_obstacles]
         out["dynamic_obstacles"] = [dict(o.spec) for o in self.moving_obstacles]
+        if self.sensing is not None:
+            out["sensing"] = self.sensing.to_dict()
         return _plain(out)
 
     def content_hash(self) -> str:
@@ -276,15 +281,41 @@ def _parse_moving(c: _Ctx, obj: Any, fld: str, index: int) -> MovingObstacle:
             motion = WaypointMotion(np.array(rows))
         except ValueError as exc:
             raise c.fail(_join(fld, "keyframes"), str(exc)) from None
+    elif kind == "track":
+        motion = _parse_track(c, m, fld)
     else:
-        close = difflib.get_close_matches(str(kind), ["unicycle", "waypoints"], n=1)
+        close = difflib.get_close_matches(str(kind), ["unicycle", "waypoints", "track"], n=1)
         hint = f"; did you mean '{close[0]}'?" if close else ""
         raise c.fail(_join(fld, "type"),
-                     f"unknown motion type '{kind}'{hint} (known: unicycle, waypoints)")
+                     f"unknown motion type '{kind}'{hint} (known: unicycle, waypoints, track)")
     radius = c.number(m["radius"], _join(fld, "radius"), positive=True)
     spec = dict(m)
     spec["name"] = name
     return MovingObstacle(name, radius, motion, spec)
+
+
+def _parse_track(c: _Ctx, m: Mapping[str, Any], fld: str) -> Motion:
+    c.keys(m, fld, ("type", "samples", "radius"), ("name",))
+    rows_raw = m["samples"]
+    if not isinstance(rows_raw, list) or len(rows_raw) < 2:
+        raise c.fail(_join(fld, "samples"), "expected a list of at least 2 [t, x, y] rows")
+    rows = [c.vector(r, f"{_join(fld, 'samples')}[{i}]", 3) for i, r in enumerate(rows_raw)]
+    try:
+        return TrackMotion(np.array(rows))
+    except ValueError as exc:
+        raise c.fail(_join(fld, "samples"), str(exc)) from None
+
+
+def _parse_sensing(c: _Ctx, obj: Any) -> SensingSpec:
+    m = c.mapping(obj, "sensing")
+    c.keys(m, "sensing", ("mode",), ("noise_m", "rate_hz"))
+    mode = c.string(m["mode"], "sensing.mode")
+    noise = c.number(m.get("noise_m", SensingSpec.noise_m), "sensing.noise_m", nonneg=True)
+    rate = c.number(m.get("rate_hz", SensingSpec.rate_hz), "sensing.rate_hz", positive=True)
+    try:
+        return SensingSpec(mode, noise, rate)
+    except ValueError as exc:
+        raise c.fail("sensing.mode", str(exc)) from None
 
 
 def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
@@ -296,7 +327,7 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     c = _Ctx(source)
     top = c.mapping(data, "")
     c.keys(top, "", ("name", "arena", "robot"),
-           ("description", "time_limit", "static_obstacles", "dynamic_obstacles"))
+           ("description", "time_limit", "static_obstacles", "dynamic_obstacles", "sensing"))
     name = c.string(top["name"], "name")
     description = top.get("description", "") or ""
     if not isinstance(description, str):
@@ -338,7 +369,8 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
 
     sc = Scenario(name=name, width=width, height=height, robot=robot, static_obstacles=statics,
                   moving_obstacles=moving, description=description, time_limit=time_limit,
-                  source=source)
+                  source=source,
+                  sensing=None if top.get("sensing") is None else _parse_sensing(c, top["sensing"]))
     _check_task(c, sc)
     return sc
 

@@ -1,0 +1,43 @@
+"""The perception options shared by ``anyplan run`` and ``anyplan bench``."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+
+from anyplan.world.scenario import Scenario
+from anyplan.world.sensing import DEFAULT_NOISE_M, DEFAULT_RATE_HZ, MODES
+
+__all__ = ["add_perception_options", "apply_perception"]
+
+
+def add_perception_options(p: argparse.ArgumentParser) -> None:
+    """Add ``--perception``, ``--sensor-noise`` and ``--sensor-rate`` to ``p``."""
+    p.add_argument("--perception", default=None, metavar="MODE",
+                   help=f"what the robot knows of the moving obstacles: {' | '.join(MODES)} "
+                        "(default: the scenario's sensing block, else oracle; overrides it)")
+    p.add_argument("--sensor-noise", type=float, default=None, metavar="M",
+                   help=f"tracked: detection noise, standard deviation per axis [m] "
+                        f"(default: the scenario's, else {DEFAULT_NOISE_M:g})")
+    p.add_argument("--sensor-rate", type=float, default=None, metavar="HZ",
+                   help=f"tracked: detection rate [Hz] (default: the scenario's, else "
+                        f"{DEFAULT_RATE_HZ:g})")
+
+
+def apply_perception(command: str, scenarios: Sequence[Scenario],
+                     args: argparse.Namespace) -> list[Scenario]:
+    """The scenarios with the command line's perception options applied.
+
+    Raises:
+        UsageError: an unknown mode, a negative noise, a rate that is not > 0 (exit code 2).
+    """
+    from anyplan.cli.main import UsageError
+    from anyplan.simulation.perception import override_sensing
+
+    try:
+        return [override_sensing(sc, args.perception, args.sensor_noise, args.sensor_rate)
+                for sc in scenarios]
+    except ValueError as exc:
+        opt = ("--perception" if "mode" in str(exc) else
+               "--sensor-noise" if "noise" in str(exc) else "--sensor-rate")
+        raise UsageError(f"{command}: {opt}: {exc}") from None

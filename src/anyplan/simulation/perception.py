@@ -1,0 +1,146 @@
+"""The robot's sensor: what each perception mode lets an agent see of the moving obstacles.
+
+Modes (:class:`~anyplan.world.sensing.SensingSpec`, ``docs/scenarios.md`` "Sensing"):
+
+* ``oracle``: every obstacle within ``robot.sensing_range`` (all of them without a range), with
+  its exact pose and twist and its motion model (the paper's assumption);
+* ``twist``: the same, without the motion model (the agent must extrapolate);
+* ``tracked``: :class:`~anyplan.prediction.detection.Detection` records only, one per visible
+  obstacle and sensor frame: the centre plus Gaussian noise of ``noise_m`` [m] per axis, the
+  name and the radius, nothing else. Frames come at ``rate_hz``: the first simulation step at or
+  after each multiple of ``1 / rate_hz`` seconds. An obstacle is visible when its centre is within
+  ``robot.sensing_range`` of the robot's centre and the segment between the two centres misses
+  every static obstacle (the exact segment clearance of the geometry kernels is > 0). The
+  *centre* rule is our choice: a disc that is partly hidden is seen only if its centre is; the
+  arena walls do not occlude (everything is inside them).
+
+In every mode an obstacle exists only within its motion's span (recorded tracks): outside it,
+it is not observed. The noise comes from a Generator seeded with ``(seed, NOISE_STREAM)``, ``seed``
+being the run's seed, so that the same seed gives the same noise and the agent's own random
+stream is untouched.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from anyplan.geometry.collision import ObstacleSet
+from anyplan.prediction.base import ObstacleObservation
+from anyplan.prediction.detection import Detection
+from anyplan.world.robot import RobotState
+from anyplan.world.scenario import Scenario
+from anyplan.world.sensing import SensingSpec
+
+__all__ = ["NOISE_STREAM", "Sensor", "observe_exact", "effective_sensing", "override_sensing"]
+
+#: Second entry of the noise generator's seed sequence ``(run seed, NOISE_STREAM)``.
+NOISE_STREAM = 0x5E45
+
+
+def observe_exact(scenario: Scenario, t: float, robot: RobotState,
+                  announce: bool = True) -> tuple[ObstacleObservation, ...]:
+    """The moving obstacles that exist at time ``t`` [s] within the sensing range (if any), with
+    their exact pose and twist; with ``announce`` each carries the obstacle's motion model."""
+    rng_limit = scenario.robot.sensing_range
+    out = []
+    for o in scenario.moving_obstacles:
+        if not o.motion.exists(t):
+            continue
+        x, y, th, v, w = o.motion.state(t)
+        if rng_limit is not None and math.hypot(x - robot.x, y - robot.y) > rng_limit:
+            continue
+        out.append(ObstacleObservation(o.name, t, x, y, th, v, w, o.radius,
+                                       o.motion if announce else None))
+    return tuple(out)
+
+
+def effective_sensing(scenario: Scenario, announce_motions: bool = True) -> SensingSpec:
+    """The scenario's sensing (``oracle`` when it has none); ``announce_motions=False`` (the older
+    switch of :class:`~anyplan.simulation.simulator.SimConfig`) turns ``oracle`` into ``twist``."""
+    spec = scenario.sensing or SensingSpec()
+    if spec.mode == "oracle" and not announce_motions:
+        spec = SensingSpec("twist", spec.noise_m, spec.rate_hz)
+    return spec
+
+
+class Sensor:
+    """The sensor of one run.
+
+    Args:
+        scenario: The full scenario (the sensor reads the truth; the agent gets only its output).
+        spec: Perception settings.
+        seed: The run's seed; the noise generator is ``default_rng((seed, NOISE_STREAM))``.
+    """
+
+    def __init__(self, scenario: Scenario, spec: SensingSpec, seed: int) -> None:
+        self.scenario = scenario
+        self.spec = spec
+        self.seed_sequence = (int(seed), NOISE_STREAM)
+        self.rng = np.random.default_rng(list(self.seed_sequence))
+        self.occluders = ObstacleSet([o.shape for o in scenario.static_obstacles])
+        self.period = 1.0 / spec.rate_hz
+        self._frame = 0
+        self.frames = 0
+        self.detections = 0
+
+    def record(self) -> dict[str, object]:
+        """What to store in ``result.extra["perception"]``."""
+        return {"mode": self.spec.mode, "noise_m": self.spec.noise_m, "rate_hz": self.spec.rate_hz,
+                "noise_seed": list(self.seed_sequence), "frames": self.frames,
+                "detections": self.detections}
+
+    def visible(self, robot: RobotState, centres: np.ndarray) -> np.ndarray:
+        """Mask (N,): centres (N, 2) [m] in line of sight of the robot's centre (exact)."""
+        n = len(centres)
+        if n == 0 or len(self.occluders) == 0:
+            return np.ones(n, dtype=bool)
+        a = np.tile([robot.x, robot.y], (n, 1))
+        return self.occluders.segments_clearance(a, centres) > 0.0
+
+    def observe(self, t: float, robot: RobotState
+                ) -> tuple[tuple[ObstacleObservation, ...], tuple[Detection, ...]]:
+        """(exact observations, detections) at time ``t`` [s]; one of the two is empty."""
+        mode = self.spec.mode
+        if mode != "tracked":
+            return observe_exact(self.scenario, t, robot, mode == "oracle"), ()
+        if t < self._frame * self.period - 1e-9:
+            return (), ()
+        while self._frame * self.period <= t + 1e-9:
+            self._frame += 1
+        self.frames += 1
+        movers = [o for o in self.scenario.moving_obstacles if o.motion.exists(t)]
+        if not movers:
+            return (), ()
+        p = np.array([o.position(t) for o in movers]).reshape(-1, 2)
+        keep = np.ones(len(movers), dtype=bool)
+        rng_limit = self.scenario.robot.sensing_range
+        if rng_limit is not None:
+            keep &= np.hypot(p[:, 0] - robot.x, p[:, 1] - robot.y) <= rng_limit
+        idx = np.flatnonzero(keep)
+        idx = idx[self.visible(robot, p[idx])]
+        noise = self.rng.normal(0.0, self.spec.noise_m, size=(len(idx), 2)) \
+            if self.spec.noise_m > 0.0 else np.zeros((len(idx), 2))
+        out = tuple(Detection(movers[i].name, t, float(p[i, 0] + e[0]), float(p[i, 1] + e[1]),
+                              movers[i].radius) for i, e in zip(idx, noise, strict=True))
+        self.detections += len(out)
+        return (), out
+
+
+def override_sensing(scenario: Scenario, mode: str | None = None, noise_m: float | None = None,
+                     rate_hz: float | None = None) -> Scenario:
+    """The scenario with its sensing settings overridden where given (None keeps the
+    scenario's, or the defaults when it has no ``sensing:`` block).
+
+    Raises:
+        ValueError: an unknown mode, a negative noise or a rate that is not > 0.
+    """
+    if mode is None and noise_m is None and rate_hz is None:
+        return scenario
+    base = scenario.sensing or SensingSpec()
+    spec = SensingSpec(base.mode if mode is None else mode,
+                       base.noise_m if noise_m is None else float(noise_m),
+                       base.rate_hz if rate_hz is None else float(rate_hz))
+    return replace(scenario, sensing=spec)

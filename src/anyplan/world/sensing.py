@@ -1,0 +1,58 @@
+"""How the robot perceives the moving obstacles: the scenario's ``sensing:`` block.
+
+Three modes (``docs/scenarios.md``, "Sensing"):
+
+* ``oracle``: every visible obstacle with its pose, twist and full motion model (the paper's
+  assumption; the default when a scenario has no ``sensing:`` block);
+* ``twist``: the current pose and twist, exact, and no future;
+* ``tracked``: noisy positions only (Gaussian, ``noise_m`` [m] standard deviation per axis), at
+  ``rate_hz`` [Hz], within ``robot.sensing_range`` and in line of sight; each detection keeps
+  the obstacle's name (perfect association) and its radius, nothing else.
+
+The sensor itself lives in :mod:`anyplan.simulation.perception`; this module only holds the
+validated settings, so that the scenario loader can parse them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = ["MODES", "SensingSpec", "DEFAULT_NOISE_M", "DEFAULT_RATE_HZ"]
+
+#: Known perception modes.
+MODES = ("oracle", "twist", "tracked")
+#: Default position noise [m] (standard deviation per axis) of ``tracked``.
+DEFAULT_NOISE_M = 0.05
+#: Default detection rate [Hz] of ``tracked``.
+DEFAULT_RATE_HZ = 10.0
+
+
+@dataclass(frozen=True)
+class SensingSpec:
+    """Perception settings.
+
+    Attributes:
+        mode: ``oracle``, ``twist`` or ``tracked``.
+        noise_m: Standard deviation [m] of the detection noise on x and on y (``tracked``).
+        rate_hz: Detection rate [Hz] (``tracked``).
+
+    Raises:
+        ValueError: an unknown mode, a negative or non-finite noise, a rate that is not > 0.
+    """
+
+    mode: str = "oracle"
+    noise_m: float = DEFAULT_NOISE_M
+    rate_hz: float = DEFAULT_RATE_HZ
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise ValueError(f"unknown perception mode '{self.mode}' (known: {', '.join(MODES)})")
+        if not (math.isfinite(self.noise_m) and self.noise_m >= 0.0):
+            raise ValueError(f"sensor noise must be >= 0 m, got {self.noise_m:g}")
+        if not (math.isfinite(self.rate_hz) and self.rate_hz > 0.0):
+            raise ValueError(f"sensor rate must be > 0 Hz, got {self.rate_hz:g}")
+
+    def to_dict(self) -> dict[str, float | str]:
+        """The ``sensing:`` block of the YAML schema."""
+        return {"mode": self.mode, "noise_m": self.noise_m, "rate_hz": self.rate_hz}

@@ -1,0 +1,35 @@
+"""``--perception``, ``--sensor-noise`` and ``--sensor-rate`` on ``anyplan run`` and ``bench``."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from anyplan.cli.main import main
+
+
+@pytest.mark.parametrize(("argv", "words"), [
+    (["--perception", "radar"], "--perception: unknown perception mode 'radar'"),
+    (["--perception", "tracked", "--sensor-noise", "-0.1"], "--sensor-noise: sensor noise must be >= 0"),
+    (["--sensor-rate", "0"], "--sensor-rate: sensor rate must be > 0"),
+])
+@pytest.mark.parametrize("command", ["run", "bench"])
+def test_bad_perception_options_exit_2_with_one_line(tmp_path, capsys, argv, words, command):
+    base = (["run", "paper-1", "--planner", "straight", "--out", str(tmp_path / "r")]
+            if command == "run" else
+            ["bench", "--suite", "paper-1", "--runs", "1", "--jobs", "1", "--db",
+             str(tmp_path / "x.db"), "--no-progress"])
+    assert main(base + argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err
+
+
+def test_run_records_the_perception_mode(tmp_path):
+    out = tmp_path / "r"
+    assert main(["run", "paper-1", "--planner", "straight", "--out", str(out), "--no-plot",
+                 "--perception", "tracked", "--sensor-noise", "0.2", "--sensor-rate", "5",
+                 "--time-limit", "3"]) == 0
+    p = json.loads((out / "result.json").read_text())["extra"]["perception"]
+    assert p["mode"] == "tracked" and p["noise_m"] == 0.2 and p["rate_hz"] == 5.0
+    assert p["frames"] == 15 and p["noise_seed"][0] == 0

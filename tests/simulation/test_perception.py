@@ -1,0 +1,232 @@
+"""Perception modes: noise statistics and seeding, sensor rate, range, exact line of sight,
+obstacles that exist only within their recorded span, and the override of the sensing block."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from anyplan.agents.base import Agent, Observation
+from anyplan.errors import ScenarioError
+from anyplan.simulation import SimConfig, simulate
+from anyplan.simulation.perception import Sensor, effective_sensing, override_sensing
+from anyplan.world import Command, RobotState, scenario_from_dict
+from anyplan.world.sensing import SensingSpec
+from tests.conftest import small_scenario_dict
+
+
+class Recorder(Agent):
+    """Stands still and records every observation."""
+
+    name = "recorder"
+
+    def reset(self, scenario, rng):
+        self.log = []
+
+    def act(self, obs: Observation) -> Command:
+        self.log.append(obs)
+        return Command(0.0, 0.0)
+
+
+def _tracked(noise=0.05, rate=10.0, **kw):
+    d = small_scenario_dict(**kw)
+    d["sensing"] = {"mode": "tracked", "noise_m": noise, "rate_hz": rate}
+    return scenario_from_dict(d)
+
+
+def test_noise_is_gaussian_with_the_stated_sigma_and_seeded():
+    sc = _tracked(noise=0.1, static_obstacles=[])
+    robot = RobotState(1.0, 3.0, 0.0)
+    truth, meas = [], []
+    s = Sensor(sc, sc.sensing, seed=7)
+    for i in range(4000):
+        t = i * 0.1
+        _, det = s.observe(t, robot)
+        assert len(det) == 1 and det[0].name == "D1" and det[0].radius == 0.3
+        truth.append(sc.moving_obstacles[0].position(t))
+        meas.append((det[0].x, det[0].y))
+    e = np.array(meas) - np.array(truth)
+    n = len(e)
+    # mean within 4 standard errors, variance within 4 standard errors of its estimate
+    assert np.all(np.abs(e.mean(axis=0)) < 4 * 0.1 / math.sqrt(n))
+    var = e.var(axis=0)
+    assert np.all(np.abs(var - 0.01) < 4 * 0.01 * math.sqrt(2.0 / n))
+    assert abs(np.corrcoef(e.T)[0, 1]) < 4 / math.sqrt(n)
+    # the same seed gives the same noise, another seed another
+    again = Sensor(sc, sc.sensing, seed=7)
+    other = Sensor(sc, sc.sensing, seed=8)
+    a = [again.observe(i * 0.1, robot)[1][0] for i in range(5)]
+    b = [other.observe(i * 0.1, robot)[1][0] for i in range(5)]
+    assert [(d.x, d.y) for d in a] == [tuple(m) for m in meas[:5]]
+    assert [(d.x, d.y) for d in b] != [tuple(m) for m in meas[:5]]
+
+
+def test_simulated_runs_record_the_noise_seed_and_repeat():
+    sc = _tracked(static_obstacles=[])
+    runs = []
+    for _ in range(2):
+        ag = Recorder()
+        res = simulate(sc, ag, seed=3, config=SimConfig(time_limit=2.0))
+        runs.append([(d.x, d.y) for o in ag.log for d in o.detections])
+        assert res.extra["perception"]["noise_seed"][0] == 3
+        assert res.extra["perception"]["mode"] == "tracked"
+    assert runs[0] == runs[1] and len(runs[0]) == 20  # 10 Hz over 2 s
+
+
+@pytest.mark.parametrize("rate", [10.0, 3.0, 2.5])
+def test_frames_come_at_the_sensor_rate(rate):
+    sc = _tracked(rate=rate, static_obstacles=[])
+    ag = Recorder()
+    simulate(sc, ag, seed=0, config=SimConfig(time_limit=6.0))
+    times = np.array([o.t for o in ag.log if o.detections])
+    assert all(not o.obstacles for o in ag.log)  # positions only: no pose/twist records
+    k = np.arange(len(times))
+    # each frame is the first step at or after k / rate
+    assert np.all(times >= k / rate - 1e-9) and np.all(times - 0.05 < k / rate + 1e-9)
+    assert len(times) == math.floor(6.0 * rate - 1e-9) + 1
+
+
+def test_range_limits_detection():
+    d = small_scenario_dict(static_obstacles=[])
+    d["robot"]["sensing_range"] = 2.0
+    d["sensing"] = {"mode": "tracked", "noise_m": 0.0}
+    sc = scenario_from_dict(d)
+    s = Sensor(sc, sc.sensing, 0)
+    for i in range(60):
+        t = 0.1 * i
+        x, y = sc.moving_obstacles[0].position(t)
+        _, det = s.observe(t, RobotState(4.0, 3.0, 0.0))
+        assert (len(det) == 1) == (math.hypot(x - 4.0, y - 3.0) <= 2.0)
+        if det:
+            assert (det[0].x, det[0].y) == (x, y)  # zero noise: exact
+
+
+def _segment_hits_box(a, b, lo, hi):
+    """Liang-Barsky: does segment ab meet the closed axis-aligned box [lo, hi]?"""
+    t0, t1 = 0.0, 1.0
+    d = b - a
+    for k in range(2):
+        for p, q in ((-d[k], a[k] - lo[k]), (d[k], hi[k] - a[k])):
+            if p == 0.0:
+                if q < 0.0:
+                    return False
+            else:
+                r = q / p
+                if p < 0.0:
+                    t0 = max(t0, r)
+                else:
+                    t1 = min(t1, r)
+    return t0 <= t1
+
+
+def _segment_hits_circle(a, b, c, rad):
+    d = b - a
+    u = np.clip(np.dot(c - a, d) / np.dot(d, d), 0.0, 1.0)
+    return np.linalg.norm(a + u * d - c) <= rad
+
+
+def test_line_of_sight_matches_exact_segment_tests():
+    rng = np.random.default_rng(5)
+    d = small_scenario_dict(static_obstacles=[
+        {"name": "B", "type": "rectangle", "center": [4.0, 3.0], "size": [1.0, 2.0]},
+        {"name": "C", "type": "circle", "center": [2.5, 1.5], "radius": 0.6}])
+    d["sensing"] = {"mode": "tracked"}
+    sc = scenario_from_dict(d)
+    s = Sensor(sc, sc.sensing, 0)
+    robot = RobotState(1.0, 3.0, 0.0)
+    a = np.array([robot.x, robot.y])
+    pts = rng.uniform([0, 0], [8, 6], size=(3000, 2))
+    vis = s.visible(robot, pts)
+    expect = np.array([not (_segment_hits_box(a, p, np.array([3.5, 2.0]), np.array([4.5, 4.0]))
+                            or _segment_hits_circle(a, p, np.array([2.5, 1.5]), 0.6)) for p in pts])
+    assert vis.sum() > 500 and (~vis).sum() > 500
+    assert np.array_equal(vis, expect)
+
+
+def test_occluded_obstacle_is_not_detected_until_it_comes_out():
+    # D1 walks up x = 6 behind a wall at x = 4 (y in [1, 5]); the robot at (1, 3) sees it only
+    # when the sight line clears the wall's corners.
+    d = small_scenario_dict(static_obstacles=[
+        {"name": "W", "type": "rectangle", "center": [4.0, 3.0], "size": [0.2, 4.0]}],
+        dynamic_obstacles=[{"name": "D1", "start": [6.0, 0.2, 1.5708], "v": 0.5, "radius": 0.3}])
+    d["sensing"] = {"mode": "tracked", "noise_m": 0.0}
+    sc = scenario_from_dict(d)
+    s = Sensor(sc, sc.sensing, 0)
+    for i in range(110):
+        t = 0.1 * i
+        y = 0.2 + 0.5 * t
+        _, det = s.observe(t, RobotState(1.0, 3.0, 0.0))
+        # sight line from (1, 3) to (6, y) crosses x = 3.9 at 3 + (y - 3) * 2.9 / 5
+        y_at_wall = 3.0 + (y - 3.0) * 2.9 / 5.0
+        blocked = 1.0 <= y_at_wall <= 5.0
+        if abs(abs(y_at_wall - 3.0) - 2.0) > 1e-3:  # away from the grazing instants
+            assert (len(det) == 0) == blocked, t
+
+
+def _track_dict(samples, name="P1"):
+    return {"name": name, "type": "track", "radius": 0.25, "samples": samples}
+
+
+@pytest.mark.parametrize("mode", ["oracle", "twist", "tracked"])
+def test_track_obstacle_is_observed_only_within_its_span(mode):
+    d = small_scenario_dict(static_obstacles=[],
+                            dynamic_obstacles=[_track_dict([[1.0, 5, 1], [2.0, 5, 2], [3.0, 6, 2]])])
+    d["sensing"] = {"mode": mode}
+    sc = scenario_from_dict(d)
+    ag = Recorder()
+    simulate(sc, ag, seed=0, config=SimConfig(time_limit=4.0))
+    for o in ag.log:
+        seen = o.detections if mode == "tracked" else o.obstacles
+        present = 1.0 - 1e-9 <= o.t <= 3.0 + 1e-9
+        if mode == "tracked" and abs(round(o.t * 10) - o.t * 10) > 1e-6:
+            continue  # not a sensor frame
+        assert bool(seen) == present, o.t
+
+
+def test_simulator_collides_with_a_track_only_while_it_exists():
+    # The robot stands at (1, 3). A person's first sample is on the robot at t = 5: a clamped
+    # position before it would be a collision at t = 0; it must be at 5 s. Another person ends
+    # on the robot's spot at t = 1.0 minus a hair... ends 1 m away: never a collision afterwards.
+    still = {"start": [1.0, 3.0, 0.0], "goal": [7.0, 3.0]}
+    d = small_scenario_dict(static_obstacles=[], dynamic_obstacles=[
+        _track_dict([[5.0, 1.0, 3.0], [6.0, 3.0, 3.0]], "P1"),
+        _track_dict([[0.0, 6.0, 5.0], [1.0, 1.0, 4.4]], "P2")])
+    d["robot"].update(still)
+    sc = scenario_from_dict(d)
+    res = simulate(sc, Recorder(), seed=0, config=SimConfig(time_limit=8.0))
+    assert res.collision and res.collision_with == "P1"
+    assert 5.0 - 1e-9 <= res.collision_time_s <= 5.05 + 1e-9
+    # P2 stops 0.1 m from touching (1.4 m apart, radii 0.55); after t = 1 it no longer exists
+    d["dynamic_obstacles"] = [_track_dict([[0.0, 6.0, 5.0], [1.0, 1.0, 3.6]], "P2")]
+    res = simulate(scenario_from_dict(d), Recorder(), seed=0, config=SimConfig(time_limit=3.0))
+    assert not res.collision
+
+
+def test_override_and_defaults():
+    sc = scenario_from_dict(small_scenario_dict())
+    assert sc.sensing is None and effective_sensing(sc).mode == "oracle"
+    assert effective_sensing(sc, announce_motions=False).mode == "twist"
+    t = override_sensing(sc, "tracked", None, 5.0)
+    assert t.sensing == SensingSpec("tracked", 0.05, 5.0)
+    assert t.content_hash() != sc.content_hash()
+    assert override_sensing(sc) is sc
+    # round trip through the schema
+    assert scenario_from_dict(t.to_dict()).sensing == t.sensing
+    with pytest.raises(ValueError, match="noise"):
+        override_sensing(sc, noise_m=-0.1)
+
+
+@pytest.mark.parametrize(("block", "field"), [
+    ({"mode": "radar"}, "sensing.mode"),
+    ({"mode": "tracked", "noise_m": -0.1}, "sensing.noise_m"),
+    ({"mode": "tracked", "rate_hz": 0}, "sensing.rate_hz"),
+    ({"mode": "tracked", "noise": 0.1}, "sensing.noise"),
+])
+def test_bad_sensing_block_names_the_field(block, field):
+    d = small_scenario_dict()
+    d["sensing"] = block
+    with pytest.raises(ScenarioError) as ei:
+        scenario_from_dict(d, "f.yaml")
+    assert ei.value.field == field and "f.yaml" in str(ei.value)
