@@ -106,6 +106,7 @@ AGENTS.register("straight", "anyplan.agents.straight:StraightAgent")
 AGENTS.register("bitstar", "anyplan.agents.bitstar:BITStarAgent")
 AGENTS.register("seq-bitstar", "anyplan.agents.sequential:SequentialBITStarAgent")
 AGENTS.register("dovs", "anyplan.agents.dovs:DOVSAgent")
+AGENTS.register("st-bitstar", "anyplan.agents.spacetime:SpaceTimeBITStarAgent")
 
 
 def make_agent(name: str, **config: Any) -> Agent:

@@ -5,6 +5,7 @@
 * ``paper``: the built-in ``paper-1``, ``paper-2``, ``paper-3`` (1, 2 and 3 moving obstacles);
 * ``random``: generated scenarios (:mod:`anyplan.experiments.generate`), ``per_count`` for each
   number of moving obstacles 1-6, from ``random_seed``;
+* ``gaps``: 20 ``per_count`` gap worlds (:mod:`anyplan.experiments.gaps`) from ``random_seed``;
 * a folder: every ``*.yaml`` / ``*.yml`` file in it, sorted by name;
 * a comma-separated list of scenario files or built-in names.
 """
@@ -39,6 +40,10 @@ def resolve_suite(suite: str, random_seed: int = 0, per_count: int = 1) -> list[
         if per_count < 1:
             raise SuiteError(f"--random-count must be >= 1, got {per_count}")
         scenarios = random_suite(random_seed, per_count=per_count)
+    elif suite == "gaps":
+        from anyplan.experiments.gaps import gap_suite
+
+        scenarios = gap_suite(random_seed, n=20 * per_count)
     elif Path(suite).is_dir():
         files = sorted(p for p in Path(suite).iterdir() if p.suffix in (".yaml", ".yml"))
         if not files:

@@ -1,0 +1,247 @@
+"""The ``st-bitstar`` agent: BIT* paths timed in space-time among the predicted moving obstacles.
+
+Path-velocity decomposition (see ``docs/spacetime.md``):
+
+1. BIT* plans a path among the static obstacles; :func:`~anyplan.trajectory.plan_motion` smooths
+   it into a reference motion within v, omega, a and alpha.
+2. The curve is **re-timed** (:func:`anyplan.trajectory.spacetime.retime`): the earliest
+   acceleration-bounded motion along it that avoids the s-t regions of the predicted discs, so
+   the robot may slow down, wait and pass behind an obstacle.
+3. If no timing gets through within ``patience_s`` of the path's own arrival, a virtual square
+   is put where the untimed motion meets the obstacle, as Sequential BIT* does, and the detour
+   BIT* then finds is timed the same way (up to ``config.max_iterations`` paths); the first
+   path that can be timed is taken. If none can, the shortest and the last path are timed
+   again allowing waits up to ``max_wait_s``, and the earlier arrival wins.
+4. Every motion is verified with the certified continuous check
+   (:func:`anyplan.trajectory.spacetime.verify`) before it is executed. When no candidate is
+   verified free, the robot does not start one: it brakes to rest on its current reference and
+   holds (a *fallback*, recorded in ``extra.fallbacks``).
+
+The replanning loop, planning delay and tracking are those of the ``seq-bitstar`` agent
+(:class:`~anyplan.agents.sequential.SequentialBITStarAgent`); replanning happens when the
+current motion is predicted to collide (the check runs every ``check_period_s``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from anyplan.agents.base import Observation
+from anyplan.agents.sequential import HoldSegment, SequentialBITStarAgent
+from anyplan.geometry.shapes import Shape
+from anyplan.planning.sequential import SequentialConfig, SequentialResult
+from anyplan.prediction.base import PredictedObstacle
+from anyplan.trajectory.motion import brake_to_rest
+from anyplan.trajectory.spacetime import retime, verify
+from anyplan.trajectory.trajectory import Trajectory
+from anyplan.world.robot import RobotState
+from anyplan.world.scenario import Scenario
+
+__all__ = ["SpaceTimeBITStarAgent"]
+
+_DEFAULT_LOOP = SequentialConfig(max_iterations=8, wait_delays_s=(), max_time_s=0.3)
+_WARM = False
+
+
+def warm_up_spacetime() -> None:
+    """Load the s-t kernels once per process (outside any timed planning call)."""
+    global _WARM
+    if _WARM:
+        return
+    _WARM = True
+    from anyplan.geometry.collision import ObstacleSet
+    from anyplan.trajectory.motion import plan_motion
+    from anyplan.world.motion import UnicycleMotion
+    from anyplan.world.robot import RobotSpec
+
+    spec = RobotSpec(start=(0.5, 0.5, 0.0), goal=(3.5, 0.5), radius=0.2)
+    obs = ObstacleSet([], bounds=(0.0, 0.0, 4.0, 2.0))
+    tr = plan_motion(np.array([[0.5, 0.5], [3.5, 0.5]]), spec, RobotState(0.5, 0.5, 0.0), obs, 0.0)
+    mover = PredictedObstacle("X", 0.2, UnicycleMotion(2.0, 1.9, -1.5708, 0.3))
+    res = retime(tr, [mover], spec, max_wait_s=5.0)
+    if res.trajectory is not None:
+        verify(res.trajectory, [mover], spec.radius)
+
+
+class SpaceTimeBITStarAgent(SequentialBITStarAgent):
+    """BIT* candidate paths, each timed among the moving obstacles (s-t velocity planning).
+
+    Args:
+        config: The Sequential BIT* loop that supplies candidate paths (detours around virtual
+            squares); its ``margin`` [m] is the clearance kept from the moving obstacles.
+        patience_s: First, each candidate path is timed with arrivals up to this much [s] after
+            its untimed motion; the first that succeeds is taken (shorter searches, and a detour
+            is preferred to a long wait).
+        max_wait_s: When no path can be timed within ``patience_s``, the first and the last
+            path are timed again with delays up to this much [s], and the earlier arrival wins.
+        lattice_dt_s: Approximate step [s] of the velocity lattice.
+        **kwargs: Further options of :class:`SequentialBITStarAgent` (planning_delay, ...).
+    """
+
+    name = "st-bitstar"
+
+    def __init__(self, config: SequentialConfig | None = None, *, patience_s: float = 3.0,
+                 max_wait_s: float = 30.0, lattice_dt_s: float = 0.25, **kwargs: Any) -> None:
+        super().__init__(config if config is not None else _DEFAULT_LOOP, **kwargs)
+        for name, val in (("patience_s", patience_s), ("max_wait_s", max_wait_s),
+                          ("lattice_dt_s", lattice_dt_s)):
+            if not (isinstance(val, int | float) and val > 0.0):
+                raise ValueError(f"{name}: must be > 0, got {val!r}")
+        self.patience_s = float(patience_s)
+        self.max_wait_s = float(max_wait_s)
+        self.lattice_dt_s = float(lattice_dt_s)
+
+    def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
+        warm_up_spacetime()
+        super().reset(scenario, rng)
+        self._cands: list[tuple[float, Trajectory, np.ndarray, list[Shape]]] = []
+        self._tried: list[tuple[np.ndarray, list[Shape]]] = []
+        self._preds: list[PredictedObstacle] = []
+        ex = self.stats.extra
+        ex.update({"fallbacks": [], "st_waits_s": [], "st_timed": 0, "st_candidates": []})
+
+    # --- motions ---------------------------------------------------------------------------------
+    def _timed_fn(self, state: RobotState, t_start: float, max_wait_s: float):  # noqa: ANN202
+        nominal_fn = self._motion_fn(state, t_start)
+        spec, cfg = self.spec, self.config
+
+        def build(path: np.ndarray, shapes: list[Shape], delay: float) -> Trajectory:
+            if delay == 0.0:
+                self._tried.append((np.asarray(path), list(shapes)))
+            nominal = nominal_fn(path, shapes, delay)
+            if delay > 0.0 or not self._preds:
+                if not self._preds:
+                    self._cands.append((nominal.t_end, nominal, np.asarray(path), list(shapes)))
+                return nominal
+            res = retime(nominal, self._preds, spec, margin=cfg.margin, max_wait_s=max_wait_s,
+                         target_dt=self.lattice_dt_s, free_tail_m=0.5 * spec.goal_tolerance)
+            tr = res.trajectory
+            if tr is None:
+                return nominal
+            if verify(tr, self._preds, spec.radius, margin=cfg.margin,
+                      t_until=tr.t_end - self._tail_time(tr)) is not None:
+                return nominal
+            self._cands.append((tr.t_end, tr, np.asarray(path), list(shapes)))
+            return tr
+
+        return build
+
+    def _tail_time(self, tr: Trajectory) -> float:
+        """Time [s] the motion spends inside half the goal tolerance at its end (run over)."""
+        seg = tr.segments[-1]
+        plan = getattr(seg, "plan", None)
+        if plan is None:
+            return 0.0
+        s_in = plan.s[-1] - 0.5 * self.spec.goal_tolerance
+        i = int(np.searchsorted(plan.s, s_in))
+        return max(0.0, float(plan.t[-1] - plan.t[min(i, len(plan.t) - 1)]))
+
+    def _fallback(self, obs: Observation, t_switch: float, preds: list[PredictedObstacle],
+                  reason: str) -> Trajectory:
+        """Brake to rest on the current reference (or stay) and hold."""
+        state = self._state_at(obs, t_switch)
+        segs, t_rest, rest, _ = brake_to_rest(state, self.spec, self.obstacles, self.spec.radius,
+                                              t_switch)
+        segs.append(HoldSegment(rest.x, rest.y, rest.theta, t_rest, t_rest + 1e4))
+        tr = Trajectory(segs, kind="fallback-hold", lower_bound_s=0.0)
+        hit = verify(tr, preds, self.spec.radius, t_until=t_rest + 10.0) if preds else None
+        self.stats.extra["fallbacks"].append(
+            {"t": float(obs.t), "kind": "brake-hold", "reason": reason,
+             "predicted_collision_s": None if hit is None else float(hit.t)})
+        return tr
+
+    # --- planning --------------------------------------------------------------------------------
+    def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
+        dt = self._dt or 0.05
+        t = obs.t
+        d = self._expected_delay(dt)
+        t_ready = t + d
+        state = self._state_at(obs, t_ready)
+        self._cands = []
+        self._tried = []
+        self._preds = list(preds)
+        w0 = time.perf_counter()
+        res: SequentialResult = self.loop.replan(np.array([state.x, state.y]),
+                                                 np.asarray(self.spec.goal, dtype=float), preds, t,
+                                                 self._timed_fn(state, t_ready, self.patience_s))
+        if not self._cands and self._tried:
+            # No short timing: allow long waits on the shortest path and on the last detour.
+            build = self._timed_fn(state, t_ready, self.max_wait_s)
+            tried = self._tried
+            for i in sorted({0, len(tried) - 1}):
+                build(*tried[i], 0.0)
+        motion: Trajectory | None = None
+        path, shapes = res.path, [v.shape for v in res.virtual_obstacles]
+        if self._cands:
+            _, motion, path, shapes = min(self._cands, key=lambda c: c[0])
+        elif res.collision_free and res.motion is not None:
+            motion = res.motion  # type: ignore[assignment]
+        wall = time.perf_counter() - w0
+        self._last_replan = t
+        st = self.stats
+        st.planning_times_s.append(wall)
+        if self.trajectory is not None or len(st.planning_times_s) > 1:
+            st.replans += 1
+        ex = st.extra
+        ex["statuses"][res.status] = ex["statuses"].get(res.status, 0) + 1
+        ex["iterations"].append(res.iterations)
+        ex["replan_times_s"].append(t)
+        ex.setdefault("reasons", []).append(reason)
+        ex["st_candidates"].append(len(self._cands))
+        st.virtual_obstacles.extend(v.to_dict() for v in res.virtual_obstacles)
+        t_switch = t_ready
+        if self.planning_delay == "measured" and wall > d + 1e-9:
+            # Late: the computed motion starts in the past. Re-time from the state the robot
+            # will really have, on the same path (no new search).
+            w1 = time.perf_counter()
+            ex["late_plans"] += 1
+            t_switch = t + math.ceil(wall / dt - 1e-9) * dt
+            state = self._state_at(obs, t_switch)
+            motion = None
+            if len(path):
+                self._cands = []
+                self._timed_fn(state, t_switch, self.max_wait_s)(np.asarray(path), shapes, 0.0)
+                if self._cands:
+                    motion = self._cands[0][1]
+            st.planning_times_s[-1] = wall + (time.perf_counter() - w1)
+        if motion is None:
+            if self.trajectory is not None and verify(self.trajectory, preds, self.spec.radius,
+                                                      t_from=t_switch) is None:
+                return  # the current reference is still free: keep it, try again later
+            motion = self._fallback(obs, t_switch, preds, res.status)
+        else:
+            ex["st_timed"] += int(motion.kind.startswith("st+"))
+            ex["st_waits_s"].append(float(motion.info.get("wait_s", 0.0)))
+        st.plans.append({"t": t, "t_start": t_switch, "path": np.asarray(path).tolist(),
+                         "status": res.status, "kind": motion.kind,
+                         "virtual_obstacles": len(res.virtual_obstacles),
+                         "arrival_s": float(motion.t_end)})
+        self.pending = (t_switch, motion)
+
+    def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
+        t = obs.t
+        self._last_check = t
+        traj = self.trajectory
+        assert traj is not None
+        names = {p.name for p in preds}
+        new = names - self._seen
+        self._seen |= names
+        spec = self.spec
+        if t >= traj.t_end and math.hypot(obs.robot.x - spec.goal[0],
+                                          obs.robot.y - spec.goal[1]) <= spec.goal_tolerance:
+            return
+        if traj.kind == "fallback-hold" and t - self._last_replan >= self.min_replan_interval_s:
+            self._replan(obs, preds, "holding")
+            return
+        hit = verify(traj, preds, spec.radius, t_from=t, t_until=max(traj.t_end, t) + 1.0,
+                     margin=0.5 * self.config.margin)
+        if hit is None:
+            return
+        urgent = hit.t - t < self.urgent_s
+        if not urgent and not new and t - self._last_replan < self.min_replan_interval_s:
+            return
+        self._replan(obs, preds, f"collision with {hit.obstacle} predicted at {hit.t:.2f} s")

@@ -1,0 +1,139 @@
+"""The s-t obstacle map of a path: where and when the moving obstacles forbid the robot.
+
+For a path C(s) (arc length s in [0, L]) and predicted moving discs o_i(t) with radius r_i(t),
+the forbidden region of the (s, t) plane is ``{(s, t): |C(s) - o_i(t)| <= r + r_i(t) + margin}``.
+We cover it by a boolean grid of cells [c ds, (c+1) ds] x [t_map + j h, t_map + (j+1) h] and mark a
+cell forbidden when *some* point of the cell may be in that region:
+
+* every point of the path within the cell is within ds / 2 (along the curve, hence in the plane)
+  of the cell's centre point C((c + 1/2) ds);
+* over the row, the obstacle stays within ``max_speed * h / 2`` of its position at the row's
+  middle time, and its radius is at most the largest of its radii at the row's ends and middle
+  (exact for a radius that grows or shrinks monotonically, as a growing prediction does);
+
+so the cell is marked when ``|C(s_c) - o_i(t_mid)| <= r + r_i,max + margin + ds/2 + v_i h/2``.
+The map is therefore conservative: a motion that avoids every marked cell is collision-free
+with the true predicted discs (the planner still re-verifies the final timed motion with the
+certified continuous check before it is used).
+
+Predicted obstacles are :class:`~anyplan.prediction.PredictedObstacle` (constant radius) or any
+object with ``name``, ``positions(t)``, ``max_speed`` and either ``radius`` or a vectorised
+``radius_at(t)`` (absolute times [s] -> radii [m]): the radius of a prediction may grow with time.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+__all__ = ["STMap", "build_stmap", "radii_at"]
+
+_CHUNK = 16  # path cells per bounding circle of the coarse test
+
+
+def radii_at(obstacle: Any, t: np.ndarray) -> np.ndarray:
+    """Radius [m] of a predicted obstacle at absolute times ``t`` [s] (constant or ``radius_at``)."""
+    t = np.asarray(t, dtype=float)
+    fn = getattr(obstacle, "radius_at", None)
+    if callable(fn):
+        return np.broadcast_to(np.asarray(fn(t), dtype=float), t.shape).copy()
+    return np.full(t.shape, float(obstacle.radius))
+
+
+@njit(cache=True)
+def _fill(out: np.ndarray, px: np.ndarray, py: np.ndarray, cx: np.ndarray, cy: np.ndarray,
+          crad: np.ndarray, qx: np.ndarray, qy: np.ndarray, reach: np.ndarray, chunk: int,
+          n_free: int) -> None:
+    """Mark the cells (j, c) with |P_c - Q_j| <= reach_j; cells c >= n_free stay free."""
+    nrow = out.shape[0]
+    ncell = min(out.shape[1], n_free)
+    for j in range(nrow):
+        r = reach[j]
+        r2 = r * r
+        for g in range(cx.shape[0]):
+            if math.hypot(qx[j] - cx[g], qy[j] - cy[g]) - crad[g] > r:
+                continue
+            c1 = min((g + 1) * chunk, ncell)
+            for c in range(g * chunk, c1):
+                dx = px[c] - qx[j]
+                dy = py[c] - qy[j]
+                if dx * dx + dy * dy <= r2:
+                    out[j, c] = True
+
+
+class STMap:
+    """A boolean s-t map (see the module docstring).
+
+    Attributes:
+        forbidden: (rows, cells) boolean array.
+        t_map: Time [s] of the first row's start.
+        h: Row duration [s].
+        ds: Cell width [m].
+        length: Path length [m].
+        blockers: Names of the obstacles that come near the path (they may mark cells).
+    """
+
+    def __init__(self, forbidden: np.ndarray, t_map: float, h: float, ds: float, length: float,
+                 blockers: list[str]) -> None:
+        self.forbidden = forbidden
+        self.t_map, self.h, self.ds, self.length = float(t_map), float(h), float(ds), float(length)
+        self.blockers = blockers
+
+    @property
+    def horizon_s(self) -> float:
+        """Duration [s] covered by the rows."""
+        return self.forbidden.shape[0] * self.h
+
+
+def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_radius: float,
+                t_map: float, horizon_s: float, *, margin: float = 0.0, ds: float = 0.05,
+                h: float = 0.05, free_tail_m: float = 0.0) -> STMap:
+    """The s-t map of a path for the predicted ``obstacles``.
+
+    Args:
+        points_at: Function arc lengths (N,) [m] -> points (N, 2) [m] of the path.
+        length: Path length L [m].
+        obstacles: Predicted moving discs (see the module docstring).
+        robot_radius: [m].
+        t_map: Start time [s] of the map.
+        horizon_s: Duration [s] the map covers.
+        margin: Extra clearance [m] required between robot and obstacle discs.
+        ds: Cell width [m] along the path.
+        h: Row duration [s].
+        free_tail_m: The last ``free_tail_m`` metres of the path are never marked (inside the
+            goal tolerance the run is over).
+    """
+    ncell = max(1, int(math.ceil(length / ds)))
+    nrow = max(1, int(math.ceil(horizon_s / h)))
+    out = np.zeros((nrow, ncell), dtype=np.bool_)
+    sc = np.minimum((np.arange(ncell) + 0.5) * ds, length)
+    p = np.asarray(points_at(sc), dtype=float).reshape(-1, 2)
+    px, py = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
+    ng = int(math.ceil(ncell / _CHUNK))
+    cx, cy, crad = np.empty(ng), np.empty(ng), np.empty(ng)
+    for g in range(ng):
+        sl = slice(g * _CHUNK, min((g + 1) * _CHUNK, ncell))
+        cx[g], cy[g] = px[sl].mean(), py[sl].mean()
+        crad[g] = float(np.max(np.hypot(px[sl] - cx[g], py[sl] - cy[g])))
+    n_free = int(math.floor(max(length - free_tail_m, 0.0) / ds)) if free_tail_m > 0.0 else ncell
+    gx, gy = float(px.mean()), float(py.mean())
+    grad = float(np.max(np.hypot(px - gx, py - gy)))
+    t_edges = t_map + h * np.arange(nrow + 1)
+    t_mid = t_map + h * (np.arange(nrow) + 0.5)
+    blockers: list[str] = []
+    for o in obstacles:
+        q = np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2)
+        r_mid = radii_at(o, t_mid)
+        r_edge = radii_at(o, t_edges)
+        r_max = np.maximum(r_mid, np.maximum(r_edge[:-1], r_edge[1:]))
+        reach = robot_radius + r_max + margin + 0.5 * ds + 0.5 * float(o.max_speed) * h
+        if float(np.min(np.hypot(q[:, 0] - gx, q[:, 1] - gy) - grad - reach)) > 0.0:
+            continue  # never near the path
+        _fill(out, px, py, cx, cy, crad, np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(q[:, 1]),
+              np.ascontiguousarray(reach), _CHUNK, n_free)
+        blockers.append(str(o.name))
+    return STMap(out, t_map, h, ds, length, blockers)

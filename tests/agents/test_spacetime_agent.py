@@ -1,0 +1,109 @@
+"""The st-bitstar agent: waits at a gap, passes behind crossing obstacles, stays deterministic."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from anyplan.agents import AGENTS, make_agent
+from anyplan.experiments.gaps import WALL_T, WALL_X, gap_world, issue_gap_scenario
+from anyplan.planning.sequential import SequentialConfig
+from anyplan.simulation import simulate
+from anyplan.world.scenario import scenario_from_dict
+
+P3DX = {"radius": 0.3, "v_max": 0.4, "omega_max": 0.4, "a_max": 0.4, "alpha_max": 1.0,
+        "goal_tolerance": 0.2}
+
+
+def _crossing_scenario():
+    # The obstacle crosses the straight route at x = 6 m when a robot at full speed would.
+    return scenario_from_dict({
+        "name": "crossing", "time_limit": 60.0, "arena": {"width": 12.0, "height": 6.0},
+        "robot": {"start": [1.0, 3.0, 0.0], "goal": [11.0, 3.0], **P3DX},
+        "static_obstacles": [],
+        "dynamic_obstacles": [{"name": "X", "start": [6.0, 0.5, math.pi / 2], "v": 0.3,
+                               "radius": 0.3, "start_time": 13.0 - 2.5 / 0.3}]})
+
+
+def _head_on_gap():
+    # A 1.0 m gap; a walker comes through it towards the robot, then turns off to a corner.
+    y = 4.0
+    t_meet = 14.0
+    walker = {"name": "W", "type": "waypoints", "radius": 0.3,
+              "keyframes": [[0.0, 10.0, y], [t_meet - 4.0 / 0.4, 10.0, y], [t_meet, 6.0, y],
+                            [t_meet + 2.0, 5.2, y], [t_meet + 10.0, 4.8, 7.6], [1000.0, 4.8, 7.6]]}
+    return gap_world("head-on-gap", "test", np.array([1.5, 4.0]), np.array([10.5, 4.0]), y, 1.0,
+                     [walker]), t_meet
+
+
+def _fixed():
+    return dict(planning_delay=0.1, config=SequentialConfig(max_iterations=8, wait_delays_s=(),
+                                                            batches_per_plan=2, max_time_s=10.0))
+
+
+def test_registered():
+    assert "st-bitstar" in AGENTS.names()
+    assert make_agent("st-bitstar").name == "st-bitstar"
+
+
+@pytest.mark.slow
+def test_passes_behind_a_crossing_obstacle():
+    sc = _crossing_scenario()
+    r = simulate(sc, make_agent("st-bitstar", **_fixed()), seed=0)
+    assert r.status == "reached" and not r.collision
+    tr = r.trajectory_array
+    k = int(np.argmax(tr[:, 1] >= 6.0))  # the robot crosses the obstacle's track
+    ob = sc.moving_obstacles[0].motion.positions(np.array([tr[k, 0]]))[0]
+    assert ob[1] > tr[k, 2] + 0.6  # the obstacle is already past: the robot went behind it
+    assert r.min_clearance_m > 0.0
+
+
+@pytest.mark.slow
+def test_waits_at_a_gap_until_the_walker_has_passed():
+    sc, t_meet = _head_on_gap()
+    r = simulate(sc, make_agent("st-bitstar", **_fixed()), seed=0)
+    assert r.status == "reached" and not r.collision
+    tr = r.trajectory_array
+    at = tr[np.argmin(np.abs(tr[:, 0] - t_meet))]
+    assert at[1] < WALL_X - WALL_T / 2 - 0.3  # still in front of the wall when the walker is in the gap
+    through = tr[int(np.argmax(tr[:, 1] >= WALL_X)), 0]
+    assert through > t_meet  # it went through after the walker
+    rest = tr[:, 4] < 0.01
+    assert rest[(tr[:, 0] > 1.0) & (tr[:, 0] < t_meet)].sum() * r.dt_s >= 0.5  # it waited
+
+
+@pytest.mark.slow
+def test_issue_case_reaches_without_collision():
+    r = simulate(issue_gap_scenario(), make_agent("st-bitstar", **_fixed()), seed=0)
+    assert r.status == "reached" and not r.collision
+
+
+@pytest.mark.slow
+def test_deterministic_with_a_fixed_planning_delay():
+    sc = _crossing_scenario()
+    a = simulate(sc, make_agent("st-bitstar", **_fixed()), seed=3)
+    b = simulate(sc, make_agent("st-bitstar", **_fixed()), seed=3)
+    assert a.trajectory == b.trajectory
+    assert [p["path"] for p in a.plans] == [p["path"] for p in b.plans]
+
+
+@pytest.mark.slow
+def test_result_fields():
+    r = simulate(_crossing_scenario(), make_agent("st-bitstar", **_fixed()), seed=0)
+    d = json.loads(json.dumps(r.to_dict()))
+    ex = d["extra"]
+    assert isinstance(ex["fallbacks"], list)
+    assert all(set(f) >= {"t", "kind", "reason", "predicted_collision_s"} for f in ex["fallbacks"])
+    assert len(ex["st_waits_s"]) == len(d["plans"]) and all(w >= 0.0 for w in ex["st_waits_s"])
+    assert 0 <= ex["st_timed"] <= len(d["plans"])
+    assert len(ex["st_candidates"]) == len(d["planning_times_s"])
+    assert all(p["arrival_s"] >= p["t_start"] for p in d["plans"])
+    assert d["plans"][0]["kind"].startswith("st+")
+
+
+def test_bad_options():
+    with pytest.raises(ValueError, match="patience_s"):
+        make_agent("st-bitstar", patience_s=0.0)

@@ -1,0 +1,145 @@
+"""The s-t velocity planner (lattice A*) against hand cases and brute force."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from anyplan.trajectory.spacetime import edge_ok, lattice_dt, plan_velocity
+
+DS, H = 0.05, 0.05
+A, V = 0.4, 0.4
+
+
+def _caps(length: float, cap: float = V * V) -> tuple[np.ndarray, np.ndarray]:
+    n = int(math.ceil(length / DS))
+    return np.full(n, cap), np.full(n, cap)
+
+
+def _check_limits(plan, forbidden, x0, x1, length):
+    """Sample the plan every 1 ms: speed, acceleration, map and end conditions."""
+    t = np.arange(plan.t[0], plan.t[-1], 1e-3)
+    s, v, a = plan.at_time(t)
+    assert np.all(v >= -1e-9)
+    assert np.all(np.abs(a) <= A + 1e-9)
+    dv = np.diff(v) / 1e-3
+    assert np.all(np.abs(dv) <= A * (1 + 1e-6) + 1e-6)
+    cell = np.clip((s / DS).astype(int), 0, forbidden.shape[1] - 1)
+    cap = np.where(np.abs(a) > 0, x1[cell], x0[cell])
+    assert np.all(v * v <= cap * (1 + 1e-9) + 1e-12)
+    row = np.clip(((t - 0.0) / H).astype(int), 0, forbidden.shape[0] - 1)
+    assert not forbidden[row, cell].any()
+    assert plan.v[-1] == 0.0
+    dt, _ = lattice_dt(V, A)
+    assert length - A * dt * dt - 1e-9 <= plan.s[-1] <= length + 1e-9
+
+
+def test_free_path_arrives_at_the_closed_form_optimum():
+    # 10 m from rest to rest: 1 s up to 0.4 m/s, 23.5 s cruise... = L / v + v / a = 26 s.
+    length = 10.0
+    x0, x1 = _caps(length)
+    forbidden = np.zeros((1000, len(x0)), dtype=bool)
+    plan = plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, 0.0, A, V)
+    assert plan is not None
+    assert plan.arrival_s == pytest.approx(length / V + V / A, abs=1e-9)
+    assert plan.wait_s == 0.0
+    _check_limits(plan, forbidden, x0, x1, length)
+
+
+def test_waits_for_a_blocked_stretch_then_goes():
+    length = 6.0
+    x0, x1 = _caps(length)
+    forbidden = np.zeros((1000, len(x0)), dtype=bool)
+    forbidden[:200, 40:60] = True  # s in [2, 3] m blocked during the first 10 s
+    plan = plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, 0.0, A, V, key_cells=0)
+    assert plan is not None
+    _check_limits(plan, forbidden, x0, x1, length)
+    # It cannot be at s >= 2 m before t = 10 s; from there 4 m remain (>= 4 / 0.4 s).
+    assert plan.arrival_s >= 10.0 + 4.0 / V - 1e-9
+    assert plan.arrival_s <= 10.0 + 4.0 / V + V / A + 2 * lattice_dt(V, A)[0]
+
+
+def test_speed_cap_of_a_curve_is_kept():
+    length = 4.0
+    x0, x1 = _caps(length)
+    x0[30:50] = x1[30:50] = 0.2 ** 2  # a tight bend: v <= 0.2 m/s on s in [1.5, 2.5]
+    forbidden = np.zeros((600, len(x0)), dtype=bool)
+    plan = plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, 0.0, A, V)
+    assert plan is not None
+    _check_limits(plan, forbidden, x0, x1, length)
+
+
+def test_start_speed_off_the_lattice():
+    length = 3.0
+    x0, x1 = _caps(length)
+    forbidden = np.zeros((600, len(x0)), dtype=bool)
+    plan = plan_velocity(forbidden, 2.0, H, DS, x0, x1, length, 2.0, 0.13, A, V)
+    assert plan is not None
+    assert plan.t[0] == 2.0 and plan.v[0] == pytest.approx(0.13)
+    t = np.arange(plan.t[0], plan.t[-1], 1e-3)
+    _, v, _ = plan.at_time(t)
+    assert np.all(np.abs(np.diff(v)) <= A * 1e-3 * (1 + 1e-6))
+
+
+def test_no_plan_when_the_end_is_blocked_for_ever():
+    length = 2.0
+    x0, x1 = _caps(length)
+    forbidden = np.zeros((400, len(x0)), dtype=bool)
+    forbidden[:, 20:25] = True
+    assert plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, 0.0, A, V) is None
+
+
+def _brute_force(forbidden, x0, x1, length, n_max):
+    """Earliest rest at the goal over every acceleration sequence (3^n), same lattice."""
+    dt, kmax = lattice_dt(V, A)
+    delta = 0.5 * A * dt * dt
+    m_goal = int(math.floor(length / delta + 1e-9))
+    m_goal -= m_goal % 2
+    frontier = {(0, 0)}
+    for n in range(n_max + 1):
+        if (m_goal, 0) in frontier:
+            return n * dt
+        nxt = set()
+        for m, k in frontier:
+            for u in (1, 0, -1):
+                k2, m2 = k + u, m + 2 * k + u
+                if 0 <= k2 <= kmax and m2 <= m_goal and edge_ok(
+                        forbidden, 0.0, H, DS, x0, x1, n * dt, m * delta, k * A * dt, u * A, dt):
+                    nxt.add((m2, k2))
+        frontier = nxt
+    return None
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_astar_matches_brute_force_on_small_maps(seed):
+    rng = np.random.default_rng(seed)
+    length = 1.5
+    x0, x1 = _caps(length)
+    forbidden = np.zeros((240, len(x0)), dtype=bool)
+    for _ in range(3):  # random blocks in (s, t)
+        c, j = rng.integers(0, len(x0) - 3), rng.integers(0, 150)
+        forbidden[j:j + rng.integers(10, 60), c:c + rng.integers(1, 5)] = True
+    forbidden[:, :2] = False  # the start is free
+    best = _brute_force(forbidden, x0, x1, length, 46)
+    plan = plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, 0.0, A, V, key_cells=0,
+                         horizon_s=11.9)
+    if best is None:
+        assert plan is None
+        return
+    assert plan is not None
+    assert plan.arrival_s == pytest.approx(best, abs=1e-9)
+    _check_limits(plan, forbidden, x0, x1, length)
+    coarse = plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, 0.0, A, V, key_cells=2,
+                           horizon_s=11.9)
+    if coarse is not None:  # coarser keys: still valid, never earlier than the optimum
+        assert coarse.arrival_s >= best - 1e-9
+        _check_limits(coarse, forbidden, x0, x1, length)
+
+
+def test_lattice_dt_hits_v_max_exactly():
+    for v, a in ((0.4, 0.4), (2.0, 2.0), (0.5, 0.3)):
+        dt, k = lattice_dt(v, a)
+        assert k * a * dt == pytest.approx(v)
+        assert k >= 2

@@ -1,0 +1,122 @@
+"""s-t maps, re-timing along a path and the certified check (growing radii included)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from anyplan.geometry.collision import ObstacleSet
+from anyplan.prediction.base import PredictedObstacle
+from anyplan.prediction.collision import first_collision
+from anyplan.trajectory.motion import plan_motion
+from anyplan.trajectory.spacetime import build_stmap, retime, verify
+from anyplan.world.motion import UnicycleMotion
+from anyplan.world.robot import RobotSpec, RobotState
+
+SPEC = RobotSpec(start=(1.0, 2.0, 0.0), goal=(9.0, 2.0), radius=0.3, v_max=0.4, omega_max=0.4,
+                 a_max=0.4, alpha_max=1.0)
+ARENA = ObstacleSet([], bounds=(0.0, 0.0, 10.0, 4.0))
+
+
+class Growing:
+    """A prediction whose radius grows linearly with time (as an uncertain prediction does)."""
+
+    def __init__(self, name, motion, r0, rate, t0=0.0):
+        self.name, self.motion, self.r0, self.rate, self.t0 = name, motion, r0, rate, t0
+
+    def positions(self, t):
+        return self.motion.positions(t)
+
+    @property
+    def max_speed(self):
+        return self.motion.max_speed
+
+    @property
+    def radius(self):
+        return self.r0
+
+    def radius_at(self, t):
+        return self.r0 + self.rate * np.maximum(np.asarray(t, dtype=float) - self.t0, 0.0)
+
+
+def _straight():
+    path = np.array([[1.0, 2.0], [9.0, 2.0]])
+    return plan_motion(path, SPEC, RobotState(1.0, 2.0, 0.0), ARENA, 0.0)
+
+
+def _crossing(t_cross=11.0, v=0.3):
+    # Crosses the route at x = 5 going up, at the middle of its disc at t_cross.
+    return PredictedObstacle("X", 0.3, UnicycleMotion(5.0, 2.0 - v * t_cross, np.pi / 2, v))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_stmap_is_conservative(seed):
+    """Free cells: no contact anywhere in the cell over the whole row (dense samples)."""
+    rng = np.random.default_rng(seed)
+    ob = PredictedObstacle("O", 0.3, UnicycleMotion(rng.uniform(3, 7), rng.uniform(0, 1),
+                                                    rng.uniform(0.5, 2.6), rng.uniform(0.1, 0.6),
+                                                    rng.uniform(-0.2, 0.2)))
+    length, ds, h, margin = 8.0, 0.05, 0.05, 0.05
+
+    def pts(s):
+        s = np.asarray(s, dtype=float)
+        return np.column_stack([1.0 + s, np.full(s.shape, 2.0)])
+
+    m = build_stmap(pts, length, [ob], SPEC.radius, 0.0, 20.0, margin=margin, ds=ds, h=h)
+    reach = SPEC.radius + 0.3 + margin
+    free_rows, free_cells = np.nonzero(~m.forbidden)
+    pick = rng.choice(len(free_rows), size=min(3000, len(free_rows)), replace=False)
+    for j, c in zip(free_rows[pick], free_cells[pick], strict=True):
+        ts = np.linspace(j * h, (j + 1) * h, 6)
+        ss = np.linspace(c * ds, min((c + 1) * ds, length), 6)
+        p = pts(ss)
+        q = ob.positions(ts)
+        d = np.hypot(p[:, None, 0] - q[None, :, 0], p[:, None, 1] - q[None, :, 1])
+        assert d.min() > reach
+    assert m.forbidden.any()
+
+
+def test_retimed_motion_passes_behind_and_is_certified_free():
+    tr = _straight()
+    ob = _crossing()
+    assert first_collision(tr, [ob], SPEC.radius, margin=0.05) is not None  # the race fails
+    res = retime(tr, [ob], SPEC, margin=0.05)
+    new = res.trajectory
+    assert new is not None
+    assert first_collision(new, [ob], SPEC.radius, margin=0.05) is None  # exact, no sampling
+    # Behind: when the robot reaches x = 5 the obstacle is already past the route.
+    t = np.arange(new.t_start, new.t_end, 1e-3)
+    p = new.positions(t)
+    t5 = t[np.argmax(p[:, 0] >= 5.0)]
+    assert ob.positions(np.array([t5]))[0, 1] > 2.0 + 0.6
+    # Limits every 1 ms.
+    _, _, _, v, w = new.sample(t)
+    assert np.all(v <= SPEC.v_max + 1e-9) and np.all(v >= -1e-9)
+    assert np.all(np.abs(np.diff(v)) <= SPEC.a_max * 1e-3 * (1 + 1e-6) + 1e-12)
+    assert np.all(np.abs(w) <= SPEC.omega_max + 1e-9)
+    assert res.delay_s > 0.0
+
+
+def test_growing_radius_is_respected():
+    tr = _straight()
+    # Passes the route well before the robot: harmless with a constant radius ...
+    motion = UnicycleMotion(5.0, 0.2, np.pi / 2, 0.3)
+    const = PredictedObstacle("G", 0.3, motion)
+    grow = Growing("G", motion, 0.3, 0.08)
+    assert verify(tr, [const], SPEC.radius, margin=0.05) is None
+    # ... but a radius growing by 8 cm/s covers the route when the robot gets there.
+    assert verify(tr, [grow], SPEC.radius, margin=0.05) is not None
+    res = retime(tr, [grow], SPEC, margin=0.05, max_wait_s=40.0)
+    assert res.trajectory is None or verify(res.trajectory, [grow], SPEC.radius, margin=0.05) is None
+    m_c = build_stmap(lambda s: np.column_stack([1 + s, 2 + 0 * s]), 8.0, [const], 0.3, 0.0, 30.0)
+    m_g = build_stmap(lambda s: np.column_stack([1 + s, 2 + 0 * s]), 8.0, [grow], 0.3, 0.0, 30.0)
+    assert m_g.forbidden.sum() > m_c.forbidden.sum()
+    assert not (m_c.forbidden & ~m_g.forbidden).any()
+
+
+def test_retime_rejects_polyline_motions():
+    tr = _straight()
+    from anyplan.trajectory.trajectory import Trajectory
+
+    two = Trajectory(tr.segments + tr.segments, kind="polyline")
+    assert retime(two, [_crossing()], SPEC).trajectory is None
