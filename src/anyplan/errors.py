@@ -2,7 +2,34 @@
 
 from __future__ import annotations
 
-__all__ = ["AnyplanError", "ScenarioError", "UnknownNameError"]
+__all__ = ["AnyplanError", "ScenarioError", "UnknownNameError", "one_line", "shorten",
+           "MAX_MESSAGE_CHARS"]
+
+#: Longest error line printed by the command line [characters].
+MAX_MESSAGE_CHARS = 400
+
+
+def one_line(text: object, limit: int = MAX_MESSAGE_CHARS) -> str:
+    """``text`` as one bounded line: control characters (newlines, tabs, ...) escaped as
+    ``\\n``-style sequences, and the middle cut out (``...``) beyond ``limit`` characters."""
+    s = str(text)
+    if len(s) > 4 * limit:  # escape only what can be shown
+        s = s[: 2 * limit] + s[-2 * limit:]
+    s = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii")
+                for ch in s)
+    if len(s) > limit:
+        keep = max(limit - 3, 2)
+        s = s[: keep - keep // 3] + "..." + s[len(s) - keep // 3:]
+    return s
+
+
+def shorten(value: object, limit: int = 40) -> str:
+    """A user's value quoted in an error message: its repr, one line, at most ``limit`` chars."""
+    try:
+        s = repr(value) if not isinstance(value, str) else repr(value[: 4 * limit])
+    except Exception:  # noqa: BLE001 - a repr that fails is still reported
+        s = f"<{type(value).__name__}>"
+    return one_line(s, limit)
 
 
 class AnyplanError(Exception):

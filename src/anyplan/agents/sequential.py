@@ -63,6 +63,10 @@ class HoldSegment(Segment):
         return np.array([[self.x, self.y]])
 
 
+#: Longest wait [s] between two replannings after repeated failures.
+MAX_BACKOFF_S = 2.0
+
+
 class SequentialBITStarAgent(Agent):
     """Sequential BIT* with online replanning.
 
@@ -126,6 +130,8 @@ class SequentialBITStarAgent(Agent):
         self._last_t: float | None = None
         self._last_check = -math.inf
         self._last_replan = -math.inf
+        self._failures = 0  # consecutive replannings without a motion
+        self._retry_at = -math.inf  # no replanning before this time [s] (back-off)
         self._seen: set[str] = set()
         self.tracking = TrackingLog()
         ex = self.stats.extra
@@ -209,7 +215,13 @@ class SequentialBITStarAgent(Agent):
             # BIT*'s cost against solve time in the first planning (OMPL's progress property).
             ex["progress"] = [[float(a), float(b)] for a, b in res.history]
         if res.motion is None:
-            return  # keep the current reference (or stay put): the next check tries again
+            # Keep the current reference (or stay put); try again after a back-off that doubles
+            # with each consecutive failure up to MAX_BACKOFF_S, so that a goal no planning
+            # reaches costs a bounded fraction of real time.
+            self._failures += 1
+            self._retry_at = t + min(dt * 2.0 ** (self._failures - 1), MAX_BACKOFF_S)
+            return
+        self._failures = 0
         motion: Trajectory = res.motion  # type: ignore[assignment]
         t_switch = t_ready
         if self.planning_delay == "measured" and wall > d + 1e-9:
@@ -242,6 +254,8 @@ class SequentialBITStarAgent(Agent):
             self.pending = None
         if self.trajectory is None and self.pending is None:
             # The first plan: the robot stays at rest while it is computed.
+            if t < self._retry_at - 1e-9:
+                return Command(0.0, 0.0)
             self._replan(obs, preds, "initial")
             self._last_check = t
             self._seen = {p.name for p in preds}
@@ -276,4 +290,6 @@ class SequentialBITStarAgent(Agent):
         urgent = hit.t - t < self.urgent_s
         if not urgent and not new and t - self._last_replan < self.min_replan_interval_s:
             return
+        if t < self._retry_at - 1e-9:
+            return  # backing off after failed replannings
         self._replan(obs, preds, f"collision with {hit.obstacle} predicted at {hit.t:.2f} s")

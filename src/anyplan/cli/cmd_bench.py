@@ -7,6 +7,8 @@ import os
 import sys
 from pathlib import Path
 
+from anyplan.cli import checks
+
 DESCRIPTION = """\
 Run every (scenario, planner, run) in parallel processes (or on a Dask cluster) and store each
 finished run at once in an SQLite database laid out like OMPL's benchmark database. Prints
@@ -27,7 +29,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--config", action="append", default=[], metavar="NAME=JSON",
                    help="keyword config of one planner as a JSON object, e.g. "
                         "'bitstar={\"time_budget_s\": 0.2}' (repeatable; recorded in plannerConfigs)")
-    p.add_argument("--runs", type=int, default=30, help="runs per (scenario, planner) (default 30)")
+    p.add_argument("--runs", type=int, default=30,
+                   help=f"runs per (scenario, planner), at most {checks.MAX_RUNS} (default 30)")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
                    help="worker processes (default: the number of CPUs; 1 = no subprocess)")
     p.add_argument("--db", default="results.db", help="SQLite results database (default results.db)")
@@ -36,14 +39,15 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="run only the runs missing from --db (after an interruption)")
     p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                    help="run on this Dask scheduler (needs the 'dask' extra) instead of --jobs")
-    p.add_argument("--seed", type=int, default=0,
+    p.add_argument("--seed", type=checks.seed, default=0,
                    help="master seed; run i uses a seed derived from (seed, i) (default 0)")
-    p.add_argument("--random-count", type=int, default=1,
+    p.add_argument("--random-count", type=checks.count(1000), default=1,
                    help="--suite random: scenarios per number of moving obstacles 1-6 (default 1)")
-    p.add_argument("--random-seed", type=int, default=None,
+    p.add_argument("--random-seed", type=checks.seed, default=None,
                    help="--suite random: generator seed (default: --seed)")
-    p.add_argument("--dt", type=float, default=0.05, help="simulation step [s] (default 0.05)")
-    p.add_argument("--time-limit", type=float, default=None,
+    p.add_argument("--dt", type=checks.sim_step, default=0.05,
+                   help="simulation step [s], in [0.001, 0.05] (default 0.05)")
+    p.add_argument("--time-limit", type=checks.time_limit, default=None,
                    help="simulated time limit [s] (default: each scenario's)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     from anyplan.cli.perception_opts import add_perception_options
@@ -57,14 +61,17 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "best cost against planning time in the results database (progress table); "
                        "'anyplan report' draws it. Runs one at a time (wall-clock costs).")
     q.add_argument("--suite", default="paper", help="as for 'anyplan bench' (default paper)")
-    q.add_argument("--runs", type=int, default=10, help="runs per (scenario, planner) (default 10)")
-    q.add_argument("--budget", type=float, default=1.0, help="planning time per run [s] (default 1)")
+    q.add_argument("--runs", type=checks.count(checks.MAX_RUNS), default=10,
+                   help="runs per (scenario, planner) (default 10)")
+    q.add_argument("--budget", type=checks.positive_seconds, default=1.0,
+                   help="planning time per run [s] (default 1)")
     q.add_argument("--ompl", default="BITstar,InformedRRTstar,RRTstar",
                    help="OMPL geometric planners, comma-separated, or 'none' "
                         "(default BITstar,InformedRRTstar,RRTstar)")
     q.add_argument("--db", default="results.db", help="SQLite results database (default results.db)")
-    q.add_argument("--seed", type=int, default=0, help="master seed (default 0)")
-    q.add_argument("--random-count", type=int, default=1, help="--suite random: see 'anyplan bench'")
+    q.add_argument("--seed", type=checks.seed, default=0, help="master seed (default 0)")
+    q.add_argument("--random-count", type=checks.count(1000), default=1,
+                   help="--suite random: see 'anyplan bench'")
     q.add_argument("--resume", action="store_true", help="run only the runs missing from --db")
     q.add_argument("--no-progress", action="store_true", help="no progress bar")
     q.set_defaults(func=cmd_bench_planning)
@@ -99,19 +106,37 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
     if args.runs < 1:
         raise _usage(f"bench: --runs must be >= 1, got {args.runs}")
+    if args.runs > checks.MAX_RUNS:
+        raise _usage(f"bench: --runs must be <= {checks.MAX_RUNS} (the stated limit), got {args.runs}")
     if args.jobs < 1:
         raise _usage(f"bench: --jobs must be >= 1, got {args.jobs}")
+    if args.jobs > checks.MAX_JOBS:
+        raise _usage(f"bench: --jobs must be <= {checks.MAX_JOBS} (the stated limit), got {args.jobs}")
     planners = parse_planners(args.planners, args.config)
     scenarios = resolve_suite(args.suite, random_seed=args.seed if args.random_seed is None
                               else args.random_seed, per_count=args.random_count)
     from anyplan.cli.perception_opts import apply_perception
 
     scenarios = apply_perception("bench", scenarios, args)
+    n_tasks = args.runs * len(scenarios) * len(planners)
+    if n_tasks > checks.MAX_TASKS:
+        raise _usage(f"bench: {args.runs} runs x {len(scenarios)} scenarios x {len(planners)} "
+                     f"planners = {n_tasks} runs, more than the limit of {checks.MAX_TASKS}")
+    from anyplan.simulation.simulator import SimConfig
+
+    try:
+        cfg = SimConfig(dt=args.dt, time_limit=args.time_limit)
+        for sc in scenarios:
+            cfg.steps(sc.time_limit)
+    except ValueError as exc:
+        raise _usage(f"bench: {exc}") from None
     db_path = Path(args.db)
     if db_path.parent and not db_path.parent.exists():
         raise _usage(f"bench: --db {db_path}: folder {db_path.parent} does not exist")
     if args.resume and not db_path.exists():
         raise _usage(f"bench: --resume: {db_path} does not exist")
+    if args.out:
+        checks.writable_folder(args.out, "bench: --out")
     try:
         summary = run_bench(scenarios, planners, args.runs, db_path, master_seed=args.seed,
                             jobs=args.jobs, dt=args.dt, time_limit=args.time_limit,
@@ -122,7 +147,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         return 1
     hashes = {sc.content_hash() for sc in scenarios}
     configs = {(p.name, settings_string(p.config)) for p in planners}
-    with ResultsDB(db_path) as db:
+    with ResultsDB(db_path, readonly=True) as db:
         runs = [r for r in db.runs()
                 if r["scenario_hash"] in hashes and str(r["experiment_seed"]) == str(args.seed)
                 and (r["planner"], r["settings"] or "") in configs]
@@ -166,7 +191,7 @@ def cmd_bench_planning(args: argparse.Namespace) -> int:
     s = run_planning_bench(scenarios, db_path, runs=args.runs, budget_s=args.budget, ompl=ompl,
                            master_seed=args.seed, resume=args.resume, progress=not args.no_progress)
     print(f"{s.finished} planning runs now, {s.skipped} already stored in {db_path}\n")
-    with ResultsDB(db_path) as db:
+    with ResultsDB(db_path, readonly=True) as db:
         print(planning_table(db))
     print("\n(OMPL's first-solution time is the first of its sampled budgets with a solution: an "
           "upper estimate.)")
@@ -175,9 +200,11 @@ def cmd_bench_planning(args: argparse.Namespace) -> int:
 
 def cmd_report(args: argparse.Namespace) -> int:
     """Write the figures and the HTML report of a results database."""
+    from anyplan.experiments.db import check_database
+
     db = Path(args.db)
-    if not db.is_file():
-        raise _usage(f"report: {db}: no such database")
+    check_database(db, "report")  # an anyplan database, opened read-only below
+    checks.writable_folder(args.out, "report: --out")
     from anyplan.viz.report import build_report
 
     try:

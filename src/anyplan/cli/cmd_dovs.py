@@ -6,6 +6,9 @@ import argparse
 import math
 from pathlib import Path
 
+from anyplan.cli import checks
+from anyplan.errors import shorten
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``dovs-plot`` sub-command."""
@@ -18,7 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scenario", help="built-in scenario name (see 'anyplan scenarios') or YAML file")
     p.add_argument("--time", type=float, required=True, metavar="T",
                    help="simulated time [s] at which to draw the decision (>= 0)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=checks.seed, default=0, help="random seed >= 0 (default 0)")
     p.add_argument("--out", default=None, metavar="FILE.png",
                    help="output picture (default runs/dovs-SCENARIO-tT.png)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="params",
@@ -72,13 +75,11 @@ def cmd_dovs_plot(args: argparse.Namespace) -> int:
     if t_req > scenario.time_limit:
         raise UsageError(f"dovs-plot: --time {t_req:g} s is beyond the scenario's time limit "
                          f"({scenario.time_limit:g} s)")
-    out = Path(args.out or f"runs/dovs-{scenario.name}-t{t_req:g}.png")
+    out = Path(args.out or f"runs/dovs-{checks.safe_name(scenario.name)}-t{t_req:g}.png")
     if out.suffix.lower() != ".png":
-        raise UsageError(f"dovs-plot: --out {out}: the picture must be a .png file")
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise UsageError(f"dovs-plot: --out {out}: cannot create folder ({exc.strerror})") from None
+        raise UsageError(f"dovs-plot: --out {shorten(str(out), 120)}: the picture must be "
+                         "a .png file")
+    checks.writable_file(out, "dovs-plot: --out")
     agent = DOVSAgent(**_parse_params(args.params))
 
     note = ""

@@ -7,6 +7,7 @@ import json
 import math
 from pathlib import Path
 
+from anyplan.cli import checks
 from anyplan.planning.api import PLANNERS
 
 DEFAULT_TIME_S = 1.0
@@ -22,7 +23,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="planner (default bitstar)")
     p.add_argument("--time", type=float, default=DEFAULT_TIME_S,
                    help=f"time budget [s] for BIT* (default {DEFAULT_TIME_S})")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=checks.seed, default=0, help="random seed >= 0 (default 0)")
     p.add_argument("--json", default=None, metavar="FILE", help="write the result as JSON")
     p.add_argument("--plot", default=None, metavar="FILE",
                    help="write a picture (tree, samples, informed ellipse, path)")
@@ -38,10 +39,13 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
     if not (math.isfinite(args.time) and args.time > 0.0):
         raise UsageError(f"plan: --time must be > 0 seconds, got {args.time}")
-    for opt in ("json", "plot"):
-        target = getattr(args, opt)
-        if target is not None and not Path(target).parent.exists():
-            raise UsageError(f"plan: --{opt} {target}: folder {Path(target).parent} does not exist")
+    if args.time > checks.MAX_PLAN_TIME_S:
+        raise UsageError(f"plan: --time must be <= {checks.MAX_PLAN_TIME_S:g} s (the stated limit), "
+                         f"got {args.time:g}")
+    if args.json is not None:
+        checks.writable_file(args.json, "plan: --json", make_parent=False)
+    if args.plot is not None:
+        checks.writable_file(args.plot, "plan: --plot", checks.PLOT_SUFFIXES, make_parent=False)
     scenario = load_scenario(args.scenario)
     r = scenario.robot
     problem = Problem.create(scenario.obstacle_set(), r.start[:2], r.goal, r.radius)

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from anyplan.agents.base import AGENTS, make_agent
+from anyplan.cli import checks
 from anyplan.cli.perception_opts import add_perception_options, apply_perception
 from anyplan.simulation.simulator import SimConfig, simulate
 from anyplan.world.scenario import builtin_scenarios, load_scenario
@@ -22,15 +23,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scenario", help="built-in scenario name (see 'anyplan scenarios') or YAML file")
     p.add_argument("--planner", default=DEFAULT_PLANNER,
                    help=f"planner name (default {DEFAULT_PLANNER}; one of: {', '.join(AGENTS.names())})")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=checks.seed, default=0, help="random seed >= 0 (default 0)")
     p.add_argument("--out", default=None, help="output folder (default runs/SCENARIO-PLANNER-SEED)")
-    p.add_argument("--dt", type=float, default=0.05, help="simulation step [s] (default 0.05)")
-    p.add_argument("--time-limit", type=float, default=None,
+    p.add_argument("--dt", type=checks.sim_step, default=0.05,
+                   help="simulation step [s], in [0.001, 0.05] (default 0.05)")
+    p.add_argument("--time-limit", type=checks.time_limit, default=None,
                    help="simulated time limit [s] (default: the scenario's)")
     p.add_argument("--no-plot", action="store_true", help="do not write run.png")
     p.add_argument("--animate", default=None, metavar="FILE",
                    help="also write an animation of the run (.gif, or .mp4 when ffmpeg is present)")
-    p.add_argument("--speed", type=float, default=4.0,
+    p.add_argument("--speed", type=checks.playback_speed, default=4.0,
                    help="animation playback speed, x real time (default 4)")
     add_perception_options(p)
     p.set_defaults(func=cmd_run)
@@ -54,16 +56,20 @@ def cmd_run(args: argparse.Namespace) -> int:
     AGENTS.get(args.planner)  # unknown names fail here, before any work
     try:
         cfg = SimConfig(dt=args.dt, time_limit=args.time_limit)
+        cfg.steps(scenario.time_limit)
     except ValueError as exc:
         raise UsageError(f"run: {exc}") from None
-    out = Path(args.out or f"runs/{scenario.name}-{args.planner}-{args.seed}")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise UsageError(f"run: --out {out}: cannot create folder ({exc.strerror})") from None
-    if args.animate:  # check the target before simulating
+    out = Path(args.out or f"runs/{checks.safe_name(scenario.name)}-"
+                           f"{checks.safe_name(args.planner)}-{args.seed}")
+    # Every output is proven writable before simulating, so no run is lost at the end.
+    checks.writable_folder(out, "run: --out")
+    checks.writable_file(out / "result.json", "run: --out")
+    if not args.no_plot:
+        checks.writable_file(out / "run.png", "run: --out")
+    if args.animate:
         from anyplan.viz.animation import check_target
 
+        checks.writable_file(args.animate, "run: --animate", (".gif", ".mp4"))
         try:
             check_target(args.animate, args.speed)
         except ValueError as exc:
@@ -82,6 +88,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         from anyplan.viz.animation import animate_run
 
         print(f"  animation      {animate_run(scenario, result, args.animate, speed=args.speed)}")
+    if result.status == "unreachable":  # proven before the run: the goal cannot be reached
+        return 1
     return 0
 
 

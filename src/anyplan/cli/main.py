@@ -16,7 +16,7 @@ import sys
 from collections.abc import Sequence
 
 from anyplan import __version__
-from anyplan.errors import AnyplanError
+from anyplan.errors import AnyplanError, one_line
 
 __all__ = ["main", "COMMAND_MODULES", "UsageError"]
 
@@ -40,7 +40,7 @@ class _Parser(argparse.ArgumentParser):
     """An argument parser whose errors are one line and exit with code 2."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        sys.stderr.write(f"anyplan: error: {self.prog}: {message}\n")
+        sys.stderr.write(one_line(f"anyplan: error: {self.prog}: {message}") + "\n")
         sys.exit(2)
 
 
@@ -67,7 +67,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except AnyplanError as exc:
-        sys.stderr.write(f"anyplan: error: {exc}\n")
+        sys.stderr.write(one_line(f"anyplan: error: {exc}") + "\n")
         return 2
     except KeyboardInterrupt:
         sys.stderr.write("anyplan: interrupted\n")

@@ -25,7 +25,10 @@ And one table of our own, ``results(runid, encoding, data)``: the whole ``result
 run (trajectory, plans, virtual obstacles), zlib-compressed JSON.
 
 Only the coordinating process opens the database for writing; each finished run is committed in
-its own transaction, so an interruption loses no finished run.
+its own transaction, so an interruption loses no finished run. One process at a time may open a
+database for writing (a lock, :class:`~anyplan.experiments.dbfile.WriterLock`); a file that is
+not an anyplan database is refused and never modified; a run's key ``(experimentid, plannerid,
+run_index, seed)`` is UNIQUE in the schema itself, so no run is ever stored twice.
 """
 
 from __future__ import annotations
@@ -44,6 +47,13 @@ from typing import Any
 import numpy as np
 
 from anyplan import __version__
+from anyplan.experiments.dbfile import (
+    DEFAULT_LOCK_TIMEOUT_S,
+    DatabaseFileError,
+    WriterLock,
+    check_database,
+    connect_readonly,
+)
 
 __all__ = [
     "ResultsDB",
@@ -53,6 +63,8 @@ __all__ = [
     "settings_string",
     "run_row",
     "progress_rows",
+    "check_database",
+    "DatabaseFileError",
 ]
 
 SCHEMA_VERSION = "1"
@@ -63,8 +75,9 @@ STATUS: dict[int, str] = {
     4: "Timeout", 5: "Approximate solution", 6: "Exact solution", 7: "Crash", 8: "Abort",
     9: "Infeasible", 10: "Collision",
 }
-#: Our run outcome -> status value. ``error`` (the planner raised) is OMPL's "Crash".
-STATUS_OF_OUTCOME = {"reached": 6, "timeout": 4, "collision": 10, "error": 7}
+#: Our run outcome -> status value. ``error`` (the planner raised) is OMPL's "Crash";
+#: ``unreachable`` (the goal is proven out of reach before the run) is "Infeasible".
+STATUS_OF_OUTCOME = {"reached": 6, "timeout": 4, "collision": 10, "error": 7, "unreachable": 9}
 
 #: Run columns beyond experimentid/plannerid: (name, SQL type). OMPL's first, then ours.
 RUN_COLUMNS: list[tuple[str, str]] = [
@@ -192,14 +205,44 @@ class ResultsDB:
     """Read and write a results database (see the module docstring).
 
     Args:
-        path: The SQLite file; created with the schema if missing.
+        path: The SQLite file; created with the schema if missing (unless ``readonly``).
+        readonly: Open an existing database read-only (no lock, nothing can be changed).
+        lock_timeout_s: How long to wait for another writer [s] before refusing.
+
+    Raises:
+        DatabaseFileError: not an anyplan database, damaged, read-only (for writing), missing
+            (for reading), or being written by another process.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, *, readonly: bool = False,
+                 lock_timeout_s: float = DEFAULT_LOCK_TIMEOUT_S) -> None:
         self.path = Path(path)
-        self.conn = sqlite3.connect(str(self.path), timeout=30.0)
-        self.conn.execute("PRAGMA foreign_keys = ON")
-        self._create()
+        self.readonly = readonly
+        self._lock: WriterLock | None = None
+        if readonly:
+            check_database(self.path, "database")
+            self.conn = connect_readonly(self.path)
+            return
+        if self.path.is_dir():
+            raise DatabaseFileError(f"database {self.path}: is a folder, not a results database")
+        self._lock = WriterLock(self.path, "database", lock_timeout_s)
+        self._lock.acquire()
+        try:
+            # Checked under the lock: the file may have been created by the previous writer.
+            check_database(self.path, "database", must_exist=False, writable=True)
+            self.conn = sqlite3.connect(str(self.path), timeout=30.0)
+            try:
+                self.conn.execute("PRAGMA foreign_keys = ON")
+                self._create()
+            except BaseException:
+                self.conn.close()
+                raise
+        except sqlite3.DatabaseError as exc:
+            self._lock.release()
+            raise DatabaseFileError(f"database {self.path}: cannot write ({exc})") from None
+        except BaseException:
+            self._lock.release()
+            raise
 
     # ---------------------------------------------------------------- schema
     def _create(self) -> None:
@@ -229,7 +272,17 @@ class ResultsDB:
         self._add_columns("runs", RUN_COLUMNS)
         self._add_columns("progress", [("best_cost", "REAL"), ("plan_index", "INTEGER"),
                                        ("source", "TEXT")])
-        c.execute("CREATE INDEX IF NOT EXISTS runs_by_key ON runs (experimentid, plannerid, run_index, seed)")
+        c.execute("DROP INDEX IF EXISTS runs_by_key")  # the unique index below replaces it
+        try:
+            c.execute("CREATE UNIQUE INDEX IF NOT EXISTS runs_unique_key "
+                      "ON runs (experimentid, plannerid, run_index, seed)")
+        except sqlite3.IntegrityError:
+            c.rollback()
+            n = c.execute("SELECT count(*) - count(DISTINCT experimentid || ',' || plannerid || ',' "
+                          "|| run_index || ',' || seed) FROM runs WHERE run_index IS NOT NULL").fetchone()[0]
+            raise DatabaseFileError(f"database {self.path}: holds {n} runs stored twice (by an "
+                                    "older anyplan); it is left unchanged. Copy it, delete the "
+                                    "duplicate rows of table runs, then retry") from None
         for value, desc in STATUS.items():
             c.execute("INSERT OR IGNORE INTO enums VALUES ('status', ?, ?)", (value, desc))
         c.execute("INSERT OR IGNORE INTO anyplan_meta VALUES ('schema_version', ?)", (SCHEMA_VERSION,))
@@ -265,9 +318,15 @@ class ResultsDB:
                   "ORDER BY avg_solved DESC, avg_total_time ASC")
 
     def close(self) -> None:
-        """Commit and close."""
-        self.conn.commit()
-        self.conn.close()
+        """Commit, close and release the writer's lock."""
+        try:
+            if not self.readonly:
+                self.conn.commit()
+            self.conn.close()
+        finally:
+            if self._lock is not None:
+                self._lock.release()
+                self._lock = None
 
     def __enter__(self) -> ResultsDB:
         return self
@@ -320,9 +379,18 @@ class ResultsDB:
         """Insert one finished run (runs, progress, results) and commit it; returns its id."""
         cols = ["experimentid", "plannerid"] + list(row)
         vals = [experimentid, plannerid] + list(row.values())
+        key = (experimentid, plannerid, row.get("run_index"), row.get("seed"))
         with self.conn:  # one transaction: all of the run or nothing
-            cur = self.conn.execute(
-                f"INSERT INTO runs ({', '.join(cols)}) VALUES ({', '.join('?' * len(cols))})", vals)
+            try:
+                cur = self.conn.execute(
+                    f"INSERT INTO runs ({', '.join(cols)}) VALUES ({', '.join('?' * len(cols))})", vals)
+            except sqlite3.IntegrityError:  # the run is stored already: keep the first copy
+                old = self.conn.execute(
+                    "SELECT id FROM runs WHERE experimentid = ? AND plannerid = ? AND run_index = ? "
+                    "AND seed = ?", key).fetchone()
+                if old is None:
+                    raise
+                return int(old[0])
             runid = int(cur.lastrowid)
             if result is not None:
                 self.conn.executemany(

@@ -226,7 +226,10 @@ def _process_pool(tasks: Sequence[RunTask], jobs: int) -> Iterator[tuple[RunTask
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from concurrent.futures.process import BrokenProcessPool
 
-    ex = ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn"))
+    from anyplan.experiments.workers import die_with_parent
+
+    ex = ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn"),
+                             initializer=die_with_parent, initargs=(os.getpid(),))
     ok = False
     try:
         futs = {ex.submit(execute_task, t): t for t in tasks}

@@ -12,7 +12,10 @@ Each step of ``dt`` seconds:
    from the arc by less than 0.1 mm.)
 
 The run ends at the goal (within ``goal_tolerance``), at the first collision (unless
-``stop_on_collision`` is off) or at the time limit.
+``stop_on_collision`` is off) or at the time limit. Before the first step, when the visibility
+graph proves the goal out of reach among the static obstacles
+(:func:`~anyplan.simulation.feasibility.goal_unreachable`), the run ends at once with status
+``unreachable``.
 """
 
 from __future__ import annotations
@@ -25,11 +28,13 @@ from typing import Any
 import numpy as np
 
 from anyplan import __version__
-from anyplan.agents.base import Agent, Observation
+from anyplan.agents.base import Agent, AgentStats, Observation
 from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.geometry.moving import closest_approach_straight
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.simulation.perception import Sensor, effective_sensing, observe_exact
+from anyplan.simulation.feasibility import goal_unreachable
+from anyplan.world.limits import MAX_SIM_STEPS, MAX_TIME_LIMIT_S, MIN_DT_S
 from anyplan.world.robot import RobotState, step
 from anyplan.world.scenario import Scenario
 
@@ -41,8 +46,9 @@ class SimConfig:
     """Simulation settings.
 
     Attributes:
-        dt: Step and control period [s], in (0, 0.05].
-        time_limit: Maximum simulated time [s]; None uses the scenario's ``time_limit``.
+        dt: Step and control period [s], in [0.001, 0.05].
+        time_limit: Maximum simulated time [s], at most 3600; None uses the scenario's
+            ``time_limit``. A run has at most ``MAX_SIM_STEPS`` steps (see :meth:`steps`).
         stop_on_collision: End the run at the first collision.
         announce_motions: Observations carry each visible obstacle's motion model (the paper's
             assumption: the obstacles' motion is known). Off, agents get only the current pose
@@ -56,12 +62,23 @@ class SimConfig:
     time_limit: float | None = None
     stop_on_collision: bool = True
     announce_motions: bool = True
+    check_feasibility: bool = True
 
     def __post_init__(self) -> None:
-        if not 0.0 < self.dt <= 0.05:
-            raise ValueError(f"dt must be in (0, 0.05] s, got {self.dt}")
-        if self.time_limit is not None and not self.time_limit > 0.0:
-            raise ValueError(f"time_limit must be > 0 s, got {self.time_limit}")
+        if not MIN_DT_S <= self.dt <= 0.05:
+            raise ValueError(f"dt must be in [{MIN_DT_S:g}, 0.05] s, got {self.dt}")
+        if self.time_limit is not None and not 0.0 < self.time_limit <= MAX_TIME_LIMIT_S:
+            raise ValueError(f"time_limit must be in (0, {MAX_TIME_LIMIT_S:g}] s, "
+                             f"got {self.time_limit}")
+
+    def steps(self, scenario_time_limit: float) -> int:
+        """Number of simulation steps of a run (``ValueError`` beyond ``MAX_SIM_STEPS``)."""
+        limit = self.time_limit if self.time_limit is not None else scenario_time_limit
+        n = int(math.ceil(limit / self.dt - 1e-9))
+        if n > MAX_SIM_STEPS:
+            raise ValueError(f"time limit {limit:g} s / dt {self.dt:g} s = {n} steps, more than "
+                             f"the limit of {MAX_SIM_STEPS}")
+        return n
 
 
 @dataclass
@@ -141,15 +158,18 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
     """
     cfg = config or SimConfig()
     dt = cfg.dt
-    limit = cfg.time_limit if cfg.time_limit is not None else scenario.time_limit
-    n_max = int(math.ceil(limit / dt - 1e-9))
+    n_max = cfg.steps(scenario.time_limit)
     spec = scenario.robot
     r = spec.radius
     obstacles = scenario.obstacle_set()
     movers = scenario.moving_obstacles
     wall0 = time.perf_counter()
     sensor = Sensor(scenario, effective_sensing(scenario, cfg.announce_motions), seed)
-    agent.reset(scenario.static_only(), np.random.default_rng(seed))
+    unreachable = cfg.check_feasibility and goal_unreachable(scenario)
+    if unreachable:
+        n_max = 0  # nothing to simulate
+    else:
+        agent.reset(scenario.static_only(), np.random.default_rng(seed))
 
     state = RobotState(*spec.start, 0.0, 0.0)
     t = 0.0
@@ -220,7 +240,9 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
 
     collided = collision_with is not None
     status = "collision" if collided else ("reached" if reached else "timeout")
-    st = agent.stats
+    if unreachable:
+        status = "unreachable"
+    st = AgentStats() if unreachable else agent.stats
     return RunResult(
         scenario=scenario.name,
         planner=agent.name,

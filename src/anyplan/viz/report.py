@@ -302,7 +302,7 @@ def build_report(db_path: str | Path, out: str | Path) -> list[Path]:
     """Write the figures, tables and ``report.html`` of ``db_path`` into ``out``."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    with ResultsDB(db_path) as db:
+    with ResultsDB(db_path, readonly=True) as db:
         runs = db.runs()
         tables = summarize(runs)
         ptables = summarize(paper_runs(runs))

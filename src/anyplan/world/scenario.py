@@ -21,12 +21,14 @@ from typing import Any
 import numpy as np
 import yaml
 
-from anyplan.errors import ScenarioError, UnknownNameError
+from anyplan.errors import ScenarioError, UnknownNameError, shorten
+from anyplan.world import limits as L
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.geometry.shapes import Circle, Polygon, Shape, rectangle
 from anyplan.world.motion import Motion, TrackMotion, UnicycleMotion, WaypointMotion
 from anyplan.world.robot import RobotSpec
 from anyplan.world.sensing import SensingSpec
+from anyplan.world.yaml_load import YamlLimitError, load_yaml
 
 __all__ = [
     "StaticObstacle",
@@ -169,31 +171,55 @@ class _Ctx:
             if key not in known:
                 close = difflib.get_close_matches(str(key), known, n=1)
                 hint = f"; did you mean '{close[0]}'?" if close else ""
-                raise self.fail(_join(fld, str(key)), f"unknown key{hint} (known: {', '.join(known)})")
+                raise self.fail(_join(fld, shorten(key, 40).strip("'")),
+                                f"unknown key{hint} (known: {', '.join(known)})")
         for key in required:
             if key not in obj:
                 raise self.fail(_join(fld, key), "missing required key")
 
-    def number(self, obj: Any, fld: str, *, positive: bool = False, nonneg: bool = False) -> float:
+    def number(self, obj: Any, fld: str, *, positive: bool = False, nonneg: bool = False,
+               lo: float | None = None, hi: float | None = None) -> float:
+        """A finite number; ``lo``/``hi`` are the stated limits (inclusive), ``hi`` also
+        bounds the magnitude when ``lo`` is None."""
         if isinstance(obj, bool) or not isinstance(obj, int | float):
             raise self.fail(fld, f"expected a number, got {_typename(obj)}")
-        x = float(obj)
+        try:
+            x = float(obj)
+        except OverflowError:
+            raise self.fail(fld, "number too large (beyond the floating-point range)") from None
         if not math.isfinite(x):
             raise self.fail(fld, f"must be finite, got {x}")
         if positive and not x > 0.0:
             raise self.fail(fld, f"must be > 0, got {x:g}")
         if nonneg and x < 0.0:
             raise self.fail(fld, f"must be >= 0, got {x:g}")
+        if lo is not None and x < lo:
+            raise self.fail(fld, f"must be >= {lo:g} (the stated limit), got {x:g}")
+        if hi is not None and (x > hi or (lo is None and x < -hi)):
+            bound = f"<= {hi:g}" if lo is not None or positive or nonneg else f"within +-{hi:g}"
+            raise self.fail(fld, f"must be {bound} (the stated limit), got {x:g}")
         return x
 
-    def vector(self, obj: Any, fld: str, n: int) -> tuple[float, ...]:
+    def vector(self, obj: Any, fld: str, n: int, hi: float = L.MAX_COORD_M) -> tuple[float, ...]:
         if not isinstance(obj, list | tuple) or len(obj) != n:
             raise self.fail(fld, f"expected a list of {n} numbers, got {_short(obj)}")
-        return tuple(self.number(v, f"{fld}[{i}]") for i, v in enumerate(obj))
+        return tuple(self.number(v, f"{fld}[{i}]", hi=hi) for i, v in enumerate(obj))
 
     def string(self, obj: Any, fld: str) -> str:
         if not isinstance(obj, str) or not obj:
             raise self.fail(fld, f"expected a non-empty string, got {_typename(obj)}")
+        if len(obj) > L.MAX_TEXT_CHARS:
+            raise self.fail(fld, f"longer than {L.MAX_TEXT_CHARS} characters")
+        return obj
+
+    def items(self, obj: Any, fld: str, most: int) -> list[Any]:
+        """A list (None or a missing key: empty) of at most ``most`` items."""
+        if obj is None:
+            return []
+        if not isinstance(obj, list):
+            raise self.fail(fld, f"expected a list, got {_typename(obj)}")
+        if len(obj) > most:
+            raise self.fail(fld, f"more than {most} items (the stated limit), got {len(obj)}")
         return obj
 
 
@@ -206,8 +232,7 @@ def _typename(obj: Any) -> str:
 
 
 def _short(obj: Any) -> str:
-    s = repr(obj)
-    return s if len(s) <= 40 else s[:37] + "..."
+    return shorten(obj, 40)
 
 
 # --------------------------------------------------------------------------------------------
@@ -228,21 +253,23 @@ def _parse_static(c: _Ctx, obj: Any, fld: str, index: int) -> StaticObstacle:
         if kind == "rectangle":
             c.keys(m, fld, ("type", "center", "size"), ("name", "angle"))
             center = c.vector(m["center"], _join(fld, "center"), 2)
-            size = c.vector(m["size"], _join(fld, "size"), 2)
+            size = c.vector(m["size"], _join(fld, "size"), 2, hi=L.MAX_SIZE_M)
             for i, s in enumerate(size):
                 if not s > 0.0:
                     raise c.fail(f"{_join(fld, 'size')}[{i}]", f"must be > 0, got {s:g}")
-            angle = c.number(m.get("angle", 0.0), _join(fld, "angle"))
+            angle = c.number(m.get("angle", 0.0), _join(fld, "angle"), hi=L.MAX_ANGLE_RAD)
             shape = rectangle(center, size, angle)
         elif kind == "circle":
             c.keys(m, fld, ("type", "center", "radius"), ("name",))
             center = c.vector(m["center"], _join(fld, "center"), 2)
-            shape = Circle(center, c.number(m["radius"], _join(fld, "radius"), positive=True))
+            shape = Circle(center, c.number(m["radius"], _join(fld, "radius"), positive=True,
+                                            hi=L.MAX_SIZE_M))
         elif kind == "polygon":
             c.keys(m, fld, ("type", "points"), ("name",))
             pts = m["points"]
             if not isinstance(pts, list) or len(pts) < 3:
                 raise c.fail(_join(fld, "points"), "expected a list of at least 3 [x, y] points")
+            c.items(pts, _join(fld, "points"), L.MAX_POLYGON_POINTS)
             verts = [c.vector(p, f"{_join(fld, 'points')}[{i}]", 2) for i, p in enumerate(pts)]
             shape = Polygon(np.array(verts))
         else:
@@ -267,20 +294,30 @@ def _parse_moving(c: _Ctx, obj: Any, fld: str, index: int) -> MovingObstacle:
     if kind == "unicycle":
         c.keys(m, fld, ("start", "v", "radius"), ("name", "type", "omega", "start_time"))
         x0, y0, th0 = c.vector(m["start"], _join(fld, "start"), 3)
-        v = c.number(m["v"], _join(fld, "v"))
-        omega = c.number(m.get("omega", 0.0), _join(fld, "omega"))
-        t0 = c.number(m.get("start_time", 0.0), _join(fld, "start_time"), nonneg=True)
+        if abs(th0) > L.MAX_ANGLE_RAD:
+            c.number(th0, f"{_join(fld, 'start')}[2]", hi=L.MAX_ANGLE_RAD)
+        v = c.number(m["v"], _join(fld, "v"), hi=L.MAX_OBSTACLE_SPEED)
+        omega = c.number(m.get("omega", 0.0), _join(fld, "omega"), hi=L.MAX_OBSTACLE_TURN_RATE)
+        t0 = c.number(m.get("start_time", 0.0), _join(fld, "start_time"), nonneg=True,
+                      hi=L.MAX_EVENT_TIME_S)
         motion = UnicycleMotion(x0, y0, th0, v, omega, t0)
     elif kind == "waypoints":
         c.keys(m, fld, ("type", "keyframes", "radius"), ("name",))
         kf = m["keyframes"]
         if not isinstance(kf, list) or len(kf) < 2:
             raise c.fail(_join(fld, "keyframes"), "expected a list of at least 2 [t, x, y] rows")
-        rows = [c.vector(r, f"{_join(fld, 'keyframes')}[{i}]", 3) for i, r in enumerate(kf)]
+        c.items(kf, _join(fld, "keyframes"), L.MAX_KEYFRAMES)
+        rows = [c.vector(r, f"{_join(fld, 'keyframes')}[{i}]", 3, hi=L.MAX_EVENT_TIME_S)
+                for i, r in enumerate(kf)]
+        _check_rows(c, rows, _join(fld, "keyframes"))
         try:
             motion = WaypointMotion(np.array(rows))
-        except ValueError as exc:
+            speed = motion.max_speed
+        except (ValueError, FloatingPointError) as exc:
             raise c.fail(_join(fld, "keyframes"), str(exc)) from None
+        if not speed <= L.MAX_OBSTACLE_SPEED:
+            raise c.fail(_join(fld, "keyframes"), f"a segment is faster than "
+                         f"{L.MAX_OBSTACLE_SPEED:g} m/s (the stated limit)")
     elif kind == "track":
         motion = _parse_track(c, m, fld)
     else:
@@ -288,10 +325,18 @@ def _parse_moving(c: _Ctx, obj: Any, fld: str, index: int) -> MovingObstacle:
         hint = f"; did you mean '{close[0]}'?" if close else ""
         raise c.fail(_join(fld, "type"),
                      f"unknown motion type '{kind}'{hint} (known: unicycle, waypoints, track)")
-    radius = c.number(m["radius"], _join(fld, "radius"), positive=True)
+    radius = c.number(m["radius"], _join(fld, "radius"), positive=True, hi=L.MAX_SIZE_M)
     spec = dict(m)
     spec["name"] = name
     return MovingObstacle(name, radius, motion, spec)
+
+
+def _check_rows(c: _Ctx, rows: list[tuple[float, ...]], fld: str) -> None:
+    """Rows (t, x, y): times in [0, MAX_EVENT_TIME_S], coordinates within +-MAX_COORD_M."""
+    for i, (t, x, y) in enumerate(rows):
+        c.number(t, f"{fld}[{i}][0]", nonneg=True, hi=L.MAX_EVENT_TIME_S)
+        c.number(x, f"{fld}[{i}][1]", hi=L.MAX_COORD_M)
+        c.number(y, f"{fld}[{i}][2]", hi=L.MAX_COORD_M)
 
 
 def _parse_track(c: _Ctx, m: Mapping[str, Any], fld: str) -> Motion:
@@ -299,7 +344,10 @@ def _parse_track(c: _Ctx, m: Mapping[str, Any], fld: str) -> Motion:
     rows_raw = m["samples"]
     if not isinstance(rows_raw, list) or len(rows_raw) < 2:
         raise c.fail(_join(fld, "samples"), "expected a list of at least 2 [t, x, y] rows")
-    rows = [c.vector(r, f"{_join(fld, 'samples')}[{i}]", 3) for i, r in enumerate(rows_raw)]
+    c.items(rows_raw, _join(fld, "samples"), L.MAX_KEYFRAMES)
+    rows = [c.vector(r, f"{_join(fld, 'samples')}[{i}]", 3, hi=L.MAX_EVENT_TIME_S)
+            for i, r in enumerate(rows_raw)]
+    _check_rows(c, rows, _join(fld, "samples"))
     try:
         return TrackMotion(np.array(rows))
     except ValueError as exc:
@@ -310,8 +358,10 @@ def _parse_sensing(c: _Ctx, obj: Any) -> SensingSpec:
     m = c.mapping(obj, "sensing")
     c.keys(m, "sensing", ("mode",), ("noise_m", "rate_hz"))
     mode = c.string(m["mode"], "sensing.mode")
-    noise = c.number(m.get("noise_m", SensingSpec.noise_m), "sensing.noise_m", nonneg=True)
-    rate = c.number(m.get("rate_hz", SensingSpec.rate_hz), "sensing.rate_hz", positive=True)
+    noise = c.number(m.get("noise_m", SensingSpec.noise_m), "sensing.noise_m", nonneg=True,
+                     hi=L.MAX_SIZE_M)
+    rate = c.number(m.get("rate_hz", SensingSpec.rate_hz), "sensing.rate_hz", positive=True,
+                    hi=L.MAX_SENSOR_RATE_HZ)
     try:
         return SensingSpec(mode, noise, rate)
     except ValueError as exc:
@@ -329,37 +379,42 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     c.keys(top, "", ("name", "arena", "robot"),
            ("description", "time_limit", "static_obstacles", "dynamic_obstacles", "sensing"))
     name = c.string(top["name"], "name")
-    description = top.get("description", "") or ""
+    description = top.get("description")
+    if description is None:
+        description = ""
     if not isinstance(description, str):
-        raise c.fail("description", "expected a string")
-    time_limit = c.number(top.get("time_limit", 120.0), "time_limit", positive=True)
+        raise c.fail("description", f"expected a string, got {_typename(description)}")
+    if len(description) > L.MAX_TEXT_CHARS:
+        raise c.fail("description", f"longer than {L.MAX_TEXT_CHARS} characters")
+    time_limit = c.number(top.get("time_limit", 120.0), "time_limit", positive=True,
+                          hi=L.MAX_TIME_LIMIT_S)
 
     arena = c.mapping(top["arena"], "arena")
     c.keys(arena, "arena", ("width", "height"))
-    width = c.number(arena["width"], "arena.width", positive=True)
-    height = c.number(arena["height"], "arena.height", positive=True)
+    width = c.number(arena["width"], "arena.width", positive=True, hi=L.MAX_ARENA_M)
+    height = c.number(arena["height"], "arena.height", positive=True, hi=L.MAX_ARENA_M)
 
     rob = c.mapping(top["robot"], "robot")
     c.keys(rob, "robot", _ROBOT_REQUIRED, _ROBOT_OPTIONAL)
     start = c.vector(rob["start"], "robot.start", 3)
     goal = c.vector(rob["goal"], "robot.goal", 2)
-    vals = {k: c.number(rob[k], f"robot.{k}", positive=True)
-            for k in ("radius", "v_max", "omega_max", "a_max", "alpha_max")}
-    goal_tol = c.number(rob.get("goal_tolerance", 0.2), "robot.goal_tolerance", positive=True)
+    if abs(start[2]) > L.MAX_ANGLE_RAD:
+        c.number(start[2], "robot.start[2]", hi=L.MAX_ANGLE_RAD)
+    ranges = {"radius": L.ROBOT_RADIUS_M, **L.ROBOT_LIMITS}
+    vals = {k: c.number(rob[k], f"robot.{k}", positive=True, lo=lo, hi=hi)
+            for k, (lo, hi) in ranges.items()}
+    goal_tol = c.number(rob.get("goal_tolerance", 0.2), "robot.goal_tolerance", positive=True,
+                        hi=L.MAX_ARENA_M)
     sensing = rob.get("sensing_range")
     sensing_range = None if sensing is None else c.number(sensing, "robot.sensing_range",
-                                                           positive=True)
+                                                           positive=True, hi=L.MAX_COORD_M)
     robot = RobotSpec(start=(start[0], start[1], start[2]), goal=(goal[0], goal[1]),
                       goal_tolerance=goal_tol, sensing_range=sensing_range, **vals)
 
-    statics_raw = top.get("static_obstacles") or []
-    if not isinstance(statics_raw, list):
-        raise c.fail("static_obstacles", "expected a list")
+    statics_raw = c.items(top.get("static_obstacles"), "static_obstacles", L.MAX_STATIC_OBSTACLES)
     statics = tuple(_parse_static(c, o, f"static_obstacles[{i}]", i)
                     for i, o in enumerate(statics_raw))
-    moving_raw = top.get("dynamic_obstacles") or []
-    if not isinstance(moving_raw, list):
-        raise c.fail("dynamic_obstacles", "expected a list")
+    moving_raw = c.items(top.get("dynamic_obstacles"), "dynamic_obstacles", L.MAX_MOVING_OBSTACLES)
     moving = tuple(_parse_moving(c, o, f"dynamic_obstacles[{i}]", i)
                    for i, o in enumerate(moving_raw))
     names = [o.name for o in statics] + [o.name for o in moving]
@@ -413,27 +468,54 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
     s = str(name_or_path)
     path = Path(s)
     if path.suffix in (".yaml", ".yml", ".json") or path.exists():
-        if not path.exists():
-            raise ScenarioError(s, "", "no such file")
-        try:
-            text = path.read_text()
-        except (OSError, UnicodeDecodeError) as exc:
-            raise ScenarioError(s, "", f"cannot read file ({exc.__class__.__name__})") from None
-        return _from_text(text, s)
+        return _from_text(_read_file(path, s), s)
     res = resources.files("anyplan.scenarios").joinpath(f"{s}.yaml")
     if res.is_file():
         return _from_text(res.read_text(), s)
     raise UnknownNameError("scenario", s, list(builtin_scenarios()))
 
 
+def _read_file(path: Path, source: str) -> str:
+    """The text of a scenario file: a regular file (never a FIFO or device, which could block),
+    of at most the loader's document size."""
+    import os
+    import stat
+
+    from anyplan.world.yaml_load import MAX_DOCUMENT_CHARS
+
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise ScenarioError(source, "", "no such file") from None
+    except OSError as exc:
+        raise ScenarioError(source, "", f"cannot read file ({exc.strerror})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise ScenarioError(source, "", "is a folder, not a scenario file")
+    if not stat.S_ISREG(st.st_mode):
+        raise ScenarioError(source, "", "not a regular file (a pipe or a device?)")
+    if st.st_size > MAX_DOCUMENT_CHARS:
+        raise ScenarioError(source, "", f"larger than {MAX_DOCUMENT_CHARS} bytes")
+    try:
+        # O_NONBLOCK: should the file be swapped for a FIFO after the check, open() still
+        # returns at once (and the read finds nothing) instead of waiting for a writer.
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(fd, "rb") as f:
+            raw = f.read(MAX_DOCUMENT_CHARS + 1)
+    except OSError as exc:
+        raise ScenarioError(source, "", f"cannot read file ({exc.strerror})") from None
+    if len(raw) > MAX_DOCUMENT_CHARS:
+        raise ScenarioError(source, "", f"larger than {MAX_DOCUMENT_CHARS} bytes")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(source, "", f"not UTF-8 text (byte {exc.start})") from None
+
+
 def _from_text(text: str, source: str) -> Scenario:
     try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "unknown place"
-        problem = getattr(exc, "problem", None) or "malformed YAML"
-        raise ScenarioError(source, "", f"malformed YAML at {where}: {problem}") from None
+        data = load_yaml(text)
+    except YamlLimitError as exc:
+        raise ScenarioError(source, "", str(exc)) from None
     if data is None:
         raise ScenarioError(source, "", "the file is empty")
     return scenario_from_dict(data, source)

@@ -1,0 +1,155 @@
+"""A bounded, strict YAML reader for scenario files.
+
+``yaml.safe_load`` accepts documents that are valid YAML but hostile or ambiguous as input:
+
+* a duplicate key silently keeps the last value (``radius: 0.9`` then ``radius: 5.0``);
+* aliases may expand a kilobyte into gigabytes (the "billion laughs"): the loaded object is a
+  small graph, but anything that walks it (a ``repr`` in an error message, JSON) explodes;
+* deep nesting (``[[[[...]]]]``) overflows Python's recursion limit in the composer;
+* ``1e6`` is text in YAML 1.1 (read here as the number it is meant to be);
+* an integer literal of thousands of digits hits Python's int-string conversion limit.
+
+:func:`load_yaml` refuses all of these with :class:`YamlLimitError` (line and column when known)
+and keeps the limits below. They are far beyond any real scenario file.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+import yaml
+from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
+
+__all__ = ["YamlLimitError", "load_yaml", "MAX_DOCUMENT_CHARS", "MAX_DEPTH", "MAX_NODES",
+           "MAX_SCALAR_CHARS"]
+
+#: Largest document [characters].
+MAX_DOCUMENT_CHARS = 8_000_000
+#: Deepest nesting of lists and mappings.
+MAX_DEPTH = 50
+#: Most nodes of the document with every alias expanded.
+MAX_NODES = 1_000_000
+#: Longest scalar (a number, a string) [characters].
+MAX_SCALAR_CHARS = 10_000
+
+
+class YamlLimitError(ValueError):
+    """The document is malformed or exceeds a limit; ``where`` is e.g. ``"line 3, column 5"``."""
+
+    def __init__(self, message: str, where: str = "") -> None:
+        self.where = where
+        self.message = message
+        super().__init__(f"{message} at {where}" if where else message)
+
+
+def _where(node_or_mark: Any) -> str:
+    mark = getattr(node_or_mark, "start_mark", node_or_mark)
+    if mark is None or not hasattr(mark, "line"):
+        return ""
+    return f"line {mark.line + 1}, column {mark.column + 1}"
+
+
+class _StrictLoader(yaml.SafeLoader):
+    """SafeLoader with a nesting limit while composing and duplicate-key refusal."""
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent: Node | None, index: Any) -> Node:  # type: ignore[override]
+        self._depth += 1
+        try:
+            if self._depth > MAX_DEPTH:
+                raise YamlLimitError(f"nesting deeper than {MAX_DEPTH} levels",
+                                     _where(self.peek_event()))
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+    def construct_mapping(self, node: Node, deep: bool = False) -> dict[Any, Any]:  # type: ignore[override]
+        if isinstance(node, MappingNode):
+            seen: set[Any] = set()
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":
+                    continue
+                if not isinstance(key_node, ScalarNode):
+                    continue  # complex keys: the base class reports them (unhashable)
+                key = self.construct_object(key_node, deep=True)
+                try:
+                    dup = key in seen
+                except TypeError:
+                    continue
+                if dup:
+                    raise YamlLimitError(f"duplicate key {str(key)[:40]!r}", _where(key_node))
+                seen.add(key)
+        return super().construct_mapping(node, deep)  # type: ignore[arg-type]
+
+
+def _expanded_size(root: Node) -> int:
+    """Number of nodes with aliases expanded (shared nodes counted at each use), capped."""
+    sizes: dict[int, int] = {}
+    # Iterative post-order walk: aliases make the node graph a DAG (recursive ones are refused
+    # by the composer), so memoised sizes are exact.
+    stack: list[tuple[Node, bool]] = [(root, False)]
+    while stack:
+        node, expanded = stack.pop()
+        nid = id(node)
+        if nid in sizes:
+            continue
+        if isinstance(node, ScalarNode):
+            if len(node.value) > MAX_SCALAR_CHARS:
+                raise YamlLimitError(f"a value longer than {MAX_SCALAR_CHARS} characters",
+                                     _where(node))
+            sizes[nid] = 1
+            continue
+        if isinstance(node, SequenceNode):
+            children = list(node.value)
+        else:
+            children = [c for kv in node.value for c in kv]
+        if not expanded:
+            stack.append((node, True))
+            stack.extend((c, False) for c in children if id(c) not in sizes)
+            continue
+        total = 1 + sum(sizes[id(c)] for c in children)
+        if total > MAX_NODES:
+            raise YamlLimitError(f"more than {MAX_NODES} values once its aliases are expanded "
+                                 "(an alias bomb?)", _where(node))
+        sizes[nid] = total
+    return sizes[id(root)]
+
+
+# YAML 1.1 reads ``1e6`` (no dot) as text; read it as a number, as YAML 1.2 and JSON do.
+_StrictLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"))
+
+
+def load_yaml(text: str) -> Any:
+    """Parse one YAML document strictly (see the module docstring); None for an empty one.
+
+    Raises:
+        YamlLimitError: malformed YAML, a duplicate key, or a limit exceeded.
+    """
+    if len(text) > MAX_DOCUMENT_CHARS:
+        raise YamlLimitError(f"the document is larger than {MAX_DOCUMENT_CHARS} characters")
+    loader = _StrictLoader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _expanded_size(node)
+        return loader.construct_document(node)
+    except YamlLimitError:
+        raise
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        problem = getattr(exc, "problem", None) or "malformed YAML"
+        raise YamlLimitError(f"malformed YAML at {_where(mark) or 'unknown place'}: {problem}") \
+            from None
+    except ValueError as exc:  # e.g. an integer literal beyond the int-string conversion limit
+        raise YamlLimitError(f"unreadable value ({str(exc)[:80]})") from None
+    except RecursionError:
+        raise YamlLimitError(f"nesting deeper than {MAX_DEPTH} levels") from None
+    finally:
+        loader.dispose()
