@@ -12,6 +12,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import re
@@ -180,8 +181,6 @@ def writable_file(path: str | Path, opt: str, suffixes: tuple[str, ...] | None =
     except OSError as exc:
         raise OutputError(f"{opt} {shown}: cannot write ({exc.strerror or exc})") from None
     if not existed:
-        try:
+        with contextlib.suppress(OSError):
             path.unlink()
-        except OSError:
-            pass
     return path

@@ -115,7 +115,7 @@ def _check_world(w: Any, k: int, src: str) -> None:
         x, y = _num(c[0], f), _num(c[1], f)
         r = _num(c[2], f"{f}.radius", positive=True)
         X, Y = x + SHIFT[0], y + SHIFT[1]
-        if not (r <= X + 1e-9 and X <= width - r + 1e-9 and r <= Y + 1e-9 and Y <= height - r + 1e-9):
+        if not (r <= X + 1e-9 and width - r + 1e-9 >= X and r <= Y + 1e-9 and height - r + 1e-9 >= Y):
             raise BARNError(f"{f}: ({x:g}, {y:g}) r {r:g} puts the cylinder outside the arena "
                             "[-4.5, 0] x [0, 14]")
 

@@ -14,6 +14,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sqlite3
 import stat
@@ -152,10 +153,8 @@ class WriterLock:
             except OSError:
                 if time.monotonic() >= deadline:
                     holder = ""
-                    try:
+                    with contextlib.suppress(OSError):
                         holder = os.pread(fd, 32, 0).decode(errors="replace").strip()
-                    except OSError:
-                        pass
                     os.close(fd)
                     by = f" (pid {shorten(holder, 20)})" if holder else ""
                     raise DatabaseFileError(

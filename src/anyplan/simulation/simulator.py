@@ -32,8 +32,8 @@ from anyplan.agents.base import Agent, AgentStats, Observation
 from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.geometry.moving import closest_approach_straight
 from anyplan.prediction.base import ObstacleObservation
-from anyplan.simulation.perception import Sensor, effective_sensing, observe_exact
 from anyplan.simulation.feasibility import goal_unreachable
+from anyplan.simulation.perception import Sensor, effective_sensing, observe_exact
 from anyplan.world.limits import MAX_SIM_STEPS, MAX_TIME_LIMIT_S, MIN_DT_S
 from anyplan.world.robot import RobotState, step
 from anyplan.world.scenario import Scenario

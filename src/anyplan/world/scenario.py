@@ -22,9 +22,9 @@ import numpy as np
 import yaml
 
 from anyplan.errors import ScenarioError, UnknownNameError, shorten
-from anyplan.world import limits as L
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.geometry.shapes import Circle, Polygon, Shape, rectangle
+from anyplan.world import limits as L
 from anyplan.world.motion import Motion, TrackMotion, UnicycleMotion, WaypointMotion
 from anyplan.world.robot import RobotSpec
 from anyplan.world.sensing import SensingSpec
