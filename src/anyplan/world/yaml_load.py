@@ -25,7 +25,7 @@ __all__ = ["YamlLimitError", "load_yaml", "MAX_DOCUMENT_CHARS", "MAX_DEPTH", "MA
            "MAX_SCALAR_CHARS"]
 
 #: Largest document [characters].
-MAX_DOCUMENT_CHARS = 8_000_000
+MAX_DOCUMENT_CHARS = 4_000_000
 #: Deepest nesting of lists and mappings.
 MAX_DEPTH = 50
 #: Most nodes of the document with every alias expanded.
@@ -87,8 +87,10 @@ class _StrictLoader(yaml.SafeLoader):
 
 
 def _expanded_size(root: Node) -> int:
-    """Number of nodes with aliases expanded (shared nodes counted at each use), capped."""
+    """Number of nodes with aliases expanded (shared nodes counted at each use), capped; also
+    refuses nesting deeper than MAX_DEPTH and scalars longer than MAX_SCALAR_CHARS."""
     sizes: dict[int, int] = {}
+    depths: dict[int, int] = {}
     # Iterative post-order walk: aliases make the node graph a DAG (recursive ones are refused
     # by the composer), so memoised sizes are exact.
     stack: list[tuple[Node, bool]] = [(root, False)]
@@ -102,6 +104,7 @@ def _expanded_size(root: Node) -> int:
                 raise YamlLimitError(f"a value longer than {MAX_SCALAR_CHARS} characters",
                                      _where(node))
             sizes[nid] = 1
+            depths[nid] = 0
             continue
         if isinstance(node, SequenceNode):
             children = list(node.value)
@@ -112,6 +115,10 @@ def _expanded_size(root: Node) -> int:
             stack.extend((c, False) for c in children if id(c) not in sizes)
             continue
         total = 1 + sum(sizes[id(c)] for c in children)
+        depth = 1 + max((depths[id(c)] for c in children), default=0)
+        if depth > MAX_DEPTH:
+            raise YamlLimitError(f"nesting deeper than {MAX_DEPTH} levels", _where(node))
+        depths[nid] = depth
         if total > MAX_NODES:
             raise YamlLimitError(f"more than {MAX_NODES} values once its aliases are expanded "
                                  "(an alias bomb?)", _where(node))
@@ -125,6 +132,51 @@ _StrictLoader.add_implicit_resolver(
     list("-+0123456789"))
 
 
+if getattr(yaml, "__with_libyaml__", False):
+    class _CComposer(yaml.CSafeLoader):  # type: ignore[name-defined,misc]
+        """libyaml's scanner, parser and composer (fast) with our resolvers."""
+
+    _CComposer.yaml_implicit_resolvers = _StrictLoader.yaml_implicit_resolvers
+else:  # pragma: no cover - PyYAML without libyaml
+    _CComposer = None
+
+# A bracket, a quoted string (skipped whole) or a comment.
+_FLOW_TOKEN = re.compile(r"""[\[\]{}]|"(?:[^"\\]|\\.)*"|'(?:[^']|'')*'|#[^\n]*""")
+# The indentation and the "- " / "? " indicators that open a line: a bound on block nesting.
+_BLOCK_PREFIX = re.compile(r"(?m)^[ \t]*(?:[-?][ \t]+)*")
+
+
+def _flow_depth(text: str) -> int:
+    """Deepest nesting of flow brackets outside quoted strings and comments (linear time;
+    PyYAML's scanner is quadratic in it)."""
+    if text.count("[") + text.count("{") <= MAX_DEPTH:
+        return 0
+    depth = deepest = 0
+    for m in _FLOW_TOKEN.finditer(text):
+        ch = m.group()[0]
+        if ch in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif ch in "]}":
+            depth = max(depth - 1, 0)
+    return deepest
+
+
+def _compose(text: str) -> tuple[Node | None, Any]:
+    """The document's node graph and a constructor for it. libyaml composes when the text's
+    block nesting is shallow (its composer recurses in C); otherwise the pure-Python composer,
+    which counts the depth as it goes."""
+    block = max((len(m.group()) for m in _BLOCK_PREFIX.finditer(text)), default=0)
+    if _CComposer is not None and block <= 4 * MAX_DEPTH:
+        composer = _CComposer(text)
+        try:
+            return composer.get_single_node(), _StrictLoader("")
+        finally:
+            composer.dispose()
+    loader = _StrictLoader(text)
+    return loader.get_single_node(), loader
+
+
 def load_yaml(text: str) -> Any:
     """Parse one YAML document strictly (see the module docstring); None for an empty one.
 
@@ -133,9 +185,11 @@ def load_yaml(text: str) -> Any:
     """
     if len(text) > MAX_DOCUMENT_CHARS:
         raise YamlLimitError(f"the document is larger than {MAX_DOCUMENT_CHARS} characters")
-    loader = _StrictLoader(text)
+    if _flow_depth(text) > MAX_DEPTH:
+        raise YamlLimitError(f"nesting deeper than {MAX_DEPTH} levels")
+    loader = None
     try:
-        node = loader.get_single_node()
+        node, loader = _compose(text)
         if node is None:
             return None
         _expanded_size(node)
@@ -152,4 +206,5 @@ def load_yaml(text: str) -> Any:
     except RecursionError:
         raise YamlLimitError(f"nesting deeper than {MAX_DEPTH} levels") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
