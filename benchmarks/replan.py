@@ -9,7 +9,9 @@ the simulator over several seeds and reports:
   collision predictions of the loop), and of its BIT* part alone;
 * BIT* plans per replanning (the paper needed about three);
 * time to goal and path length (means over the runs that reached the goal);
-* success, collision and timeout rates.
+* success, collision and timeout rates, robot-caused collisions (at first contact the robot
+  moved towards the obstacle at more than 0.05 m/s) and safety fallbacks per run;
+* time to goal over the run's time lower bound (static shortest path at the robot's limits).
 
 The configurations compared in the same run: ``warm`` (the default: the BIT* search continues
 after each virtual obstacle is added) against ``cold`` (a new search for each iteration, as
@@ -93,6 +95,8 @@ def run_one(job: tuple[str, str, int]) -> dict[str, Any]:
         "plan_times": list(res.planning_times_s), "bitstar_times": list(ex.get("plan_time_s", [])),
         "iterations": list(ex.get("iterations", [])), "replans": res.replans,
         "virtual": len(res.virtual_obstacles), "clearance": res.min_clearance_m,
+        "robot_caused": res.collision_robot_caused, "fallbacks": len(ex.get("fallbacks", [])),
+        "over_bound": res.time_over_lower_bound,
         "wall": time.perf_counter() - t,
     }
 
@@ -112,6 +116,11 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "success": len(ok) / len(rows),
         "collision": sum(r["status"] == "collision" for r in rows) / len(rows),
         "timeout": sum(r["status"] == "timeout" for r in rows) / len(rows),
+        "n_collisions": sum(r["status"] == "collision" for r in rows),
+        "n_robot_caused": sum(bool(r.get("robot_caused")) for r in rows if r["status"] == "collision"),
+        "fallbacks": float(np.mean([r.get("fallbacks", 0) for r in rows])),
+        "over_bound": float(np.median([r["over_bound"] for r in ok if r.get("over_bound")]))
+        if any(r.get("over_bound") for r in ok) else math.nan,
         "pt_med": float(np.median(pt)) if len(pt) else math.nan,
         "pt_p95": float(np.percentile(pt, 95)) if len(pt) else math.nan,
         "bt_med": float(np.median(bt)) if len(bt) else math.nan,
@@ -150,11 +159,12 @@ def main(argv: list[str] | None = None) -> int:
 
     print(f"\nSequential BIT* online: {len(rows)} runs in {time.perf_counter() - t0:.0f} s "
           f"({args.jobs} processes; times are wall-clock on this machine)\n")
-    head = ("| scenarios | config | runs | success | collision | timeout | gen. time median / p95 [ms] "
-            "| BIT* part median [ms] | plans per replan | replans per run | time to goal [s] "
-            "| path [m] | min clearance [m] |")
+    head = ("| scenarios | config | runs | success | collisions | robot-caused collisions | timeout "
+            "| gen. time median / p95 [ms] "
+            "| BIT* part median [ms] | plans per replan | replans per run | fallbacks per run "
+            "| time to goal [s] | time / lower bound (median) | path [m] | min clearance [m] |")
     print(head)
-    print("|" + "---|" * 13)
+    print("|" + "---|" * 16)
     groups = [(f"paper-{n}", lambda r, n=n: r["key"] == f"paper-{n}") for n in (1, 2, 3)]
     groups += [(f"random, {n} moving", lambda r, n=n: r["key"].startswith("random") and r["n_moving"] == n)
                for n in range(1, 7)]
@@ -167,10 +177,12 @@ def main(argv: list[str] | None = None) -> int:
                 continue
             s = summarise(sel)
             summary[(name, c)] = s
-            print(f"| {name} | {c} | {s['runs']} | {s['success']:.0%} | {s['collision']:.0%} | "
+            print(f"| {name} | {c} | {s['runs']} | {s['success']:.0%} | {s['n_collisions']} | "
+                  f"{s['n_robot_caused']} | "
                   f"{s['timeout']:.0%} | {_fmt(s['pt_med'], 1)} / {_fmt(s['pt_p95'], 1)} | "
                   f"{_fmt(s['bt_med'], 1)} | {_fmt(s['iters'], 1)} | {_fmt(s['replans'], 1)} | "
-                  f"{_fmt(s['ttg'])} | {_fmt(s['len'])} | {_fmt(s['clear'])} |")
+                  f"{_fmt(s['fallbacks'], 1)} | {_fmt(s['ttg'])} | {_fmt(s['over_bound'], 3)} | "
+                  f"{_fmt(s['len'])} | {_fmt(s['clear'])} |")
 
     print("\nBeside the paper (Tables 2-3; ours: means over the runs that reached the goal; "
           "generation time: median per replanning, ours in ms against the paper's in ms)\n")

@@ -92,6 +92,8 @@ RUN_COLUMNS: list[tuple[str, str]] = [
     ("replans", "INTEGER"), ("virtual_obstacles", "INTEGER"), ("plans", "INTEGER"),
     ("min_clearance", "REAL"), ("collision_with", "TEXT"), ("collision_time", "REAL"),
     ("wall_time", "REAL"), ("worker", "TEXT"), ("error", "TEXT"),
+    ("robot_caused", "BOOLEAN"), ("time_lower_bound", "REAL"), ("time_over_lower_bound", "REAL"),
+    ("fallbacks", "INTEGER"),
 ]
 
 _EXPERIMENT_EXTRA = [("scenario_hash", "TEXT"), ("moving_obstacles", "INTEGER"), ("suite", "TEXT"),
@@ -149,6 +151,11 @@ def run_row(result: Mapping[str, Any] | None, *, run_index: int, seed: int, scen
         "collision_time": _fin(result.get("collision_time_s")),
         "wall_time": _fin(wall_time if wall_time is not None else result.get("wall_time_s")),
         "worker": worker, "error": error,
+        "robot_caused": (None if result.get("collision_robot_caused") is None
+                         else int(bool(result.get("collision_robot_caused")))),
+        "time_lower_bound": _fin(result.get("time_lower_bound_s")),
+        "time_over_lower_bound": _fin(result.get("time_over_lower_bound")),
+        "fallbacks": len((result.get("extra") or {}).get("fallbacks") or []),
     }
 
 

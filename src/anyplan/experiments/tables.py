@@ -7,8 +7,12 @@ the paper, plus the outcome counts the paper reports only as "crashed":
 * path generation time [s]: per run, the mean wall time of its planning calls; mean ± std over
   runs that planned at least once (this is our reading of the paper's "path generation time");
 * time to goal [s]: simulated time to reach the goal, mean ± std over successful runs;
-* successes (reached the goal without collision), crashes (collided with an obstacle),
-  timeouts (neither within the time limit), errors (the planner raised; OMPL's "Crash").
+* successes (reached the goal without collision), collisions (collided with an obstacle; the
+  paper's "crashed"), robot-caused collisions (at first contact the robot's velocity had a
+  component > 0.05 m/s towards the obstacle), timeouts (neither within the time limit), errors
+  (the planner raised; OMPL's "Crash");
+* time / lower bound: time to goal over the run's ``time_lower_bound_s`` (the static shortest
+  path at the robot's limits), mean ± std over successful runs.
 
 The paper's own numbers (Roy, Harchowdhury & Vachhani, Tables 2-3) are in :data:`PAPER_TABLES`.
 """
@@ -86,6 +90,8 @@ class TableRow:
     path_length: Stat
     generation_time: Stat
     time_to_goal: Stat
+    robot_caused: int = 0
+    time_over_bound: Stat = Stat(math.nan, math.nan, 0)
 
 
 @dataclass
@@ -127,7 +133,10 @@ def summarize(runs: Sequence[Mapping[str, Any]]) -> list[PlannerTable]:
                 path_length=Stat.of(r["path_length"] for r in ok),
                 generation_time=Stat.of(r.get("planning_time_mean") for r in rs
                                         if (r.get("planning_calls") or 0) > 0),
-                time_to_goal=Stat.of(r["time_to_goal"] for r in ok)))
+                time_to_goal=Stat.of(r["time_to_goal"] for r in ok),
+                robot_caused=sum(bool(r.get("robot_caused")) for r in rs
+                                 if r["outcome"] == "collision"),
+                time_over_bound=Stat.of(r.get("time_over_lower_bound") for r in ok)))
         tables.append(t)
     order = {"seq-bitstar": 0, "bitstar": 1, "dovs": 2}
     tables.sort(key=lambda t: (order.get(t.planner, 9), t.planner, t.settings))
@@ -135,13 +144,14 @@ def summarize(runs: Sequence[Mapping[str, Any]]) -> list[PlannerTable]:
 
 
 HEADERS = ["moving obstacles", "path length [m]", "path generation time [s]", "time to goal [s]",
-           "successes", "crashes", "timeouts", "errors"]
+           "time / lower bound", "successes", "collisions", "robot-caused collisions", "timeouts",
+           "errors"]
 
 
 def _cells(row: TableRow) -> list[str]:
     return [str(row.n_moving), row.path_length.fmt(3), row.generation_time.fmt(4),
-            row.time_to_goal.fmt(2), f"{row.successes}/{row.runs}", str(row.crashes),
-            str(row.timeouts), str(row.errors)]
+            row.time_to_goal.fmt(2), row.time_over_bound.fmt(3), f"{row.successes}/{row.runs}",
+            str(row.crashes), str(row.robot_caused), str(row.timeouts), str(row.errors)]
 
 
 def _grid(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
@@ -185,7 +195,8 @@ def format_csv(tables: Sequence[PlannerTable]) -> str:
     w = csv.writer(buf)
     w.writerow(["planner", "settings", "moving_obstacles", "runs", "successes", "crashes", "timeouts",
                 "errors", "path_length_mean_m", "path_length_std_m", "generation_time_mean_s",
-                "generation_time_std_s", "time_to_goal_mean_s", "time_to_goal_std_s"])
+                "generation_time_std_s", "time_to_goal_mean_s", "time_to_goal_std_s",
+                "robot_caused_collisions", "time_over_lower_bound_mean", "time_over_lower_bound_std"])
 
     def num(x: float) -> str:
         return "" if not math.isfinite(x) else f"{x:.6g}"
@@ -195,7 +206,8 @@ def format_csv(tables: Sequence[PlannerTable]) -> str:
             w.writerow([t.planner, t.settings, r.n_moving, r.runs, r.successes, r.crashes, r.timeouts,
                         r.errors, num(r.path_length.mean), num(r.path_length.std),
                         num(r.generation_time.mean), num(r.generation_time.std),
-                        num(r.time_to_goal.mean), num(r.time_to_goal.std)])
+                        num(r.time_to_goal.mean), num(r.time_to_goal.std), r.robot_caused,
+                        num(r.time_over_bound.mean), num(r.time_over_bound.std)])
     return buf.getvalue()
 
 

@@ -31,7 +31,15 @@ from anyplan import __version__
 from anyplan.agents.base import Agent, AgentStats, Observation
 from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.geometry.moving import closest_approach_straight
+from anyplan.planning.time_bound import scenario_time_lower_bound
 from anyplan.prediction.base import ObstacleObservation
+from anyplan.simulation.contact import (
+    approach_speed,
+    disc_contact,
+    nearest_obstacle_point,
+    robot_caused,
+    static_contact,
+)
 from anyplan.simulation.feasibility import goal_unreachable
 from anyplan.simulation.perception import Sensor, effective_sensing, observe_exact
 from anyplan.world.limits import MAX_SIM_STEPS, MAX_TIME_LIMIT_S, MIN_DT_S
@@ -87,6 +95,13 @@ class RunResult:
 
     Lengths in m, times in s, angles in rad. ``trajectory`` rows are
     ``[t, x, y, theta, v, omega]``, one per simulation step (the first at t = 0).
+
+    ``collision_robot_caused`` (None without a collision) tells whether, at the first contact,
+    the robot's velocity had a component of more than 0.05 m/s towards what it hit
+    (:mod:`anyplan.simulation.contact`); ``collision_approach_speed_mps`` is that component.
+    ``time_lower_bound_s`` is the least time from rest to the edge of the goal tolerance along
+    the static shortest path (:func:`anyplan.planning.time_bound.scenario_time_lower_bound`;
+    None without a path) and ``time_over_lower_bound`` the time to goal over it.
     """
 
     scenario: str
@@ -110,6 +125,10 @@ class RunResult:
     wall_time_s: float = 0.0
     anyplan_version: str = __version__
     extra: dict[str, Any] = field(default_factory=dict)
+    collision_robot_caused: bool | None = None
+    collision_approach_speed_mps: float | None = None
+    time_lower_bound_s: float | None = None
+    time_over_lower_bound: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-serialisable dictionary."""
@@ -178,6 +197,8 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
     min_clear = math.inf
     collision_with: str | None = None
     collision_time: float | None = None
+    caused: bool | None = None
+    approach: float | None = None
     reached = False
     time_to_goal: float | None = None
     start_clear = obstacles.clearance((state.x, state.y)) - r
@@ -210,8 +231,13 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
         c_static = obstacles.segment_clearance(a, b) - r
         step_clear = c_static
         hit = None
+        u = (b - a) / dt  # the robot's velocity over the step's chord [m/s]
         if c_static < -COLLISION_EPS:
             hit = scenario.nearest_static(a, b)
+            if collision_with is None:
+                pc = a + static_contact(obstacles, a, b, r) * (b - a)
+                q = nearest_obstacle_point(obstacles, pc)
+                approach, caused = approach_speed(u, pc, q), robot_caused(u, pc, q)
         if movers:
             p_new = np.array([o.position(t_new) for o in movers])
             for j, o in enumerate(movers):
@@ -219,13 +245,17 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
                 s0, s1 = max(t, lo) - t, min(t_new, hi) - t
                 if s1 < s0:
                     continue
-                _, d = closest_approach_straight(a, (b - a) / dt, p_obs[j], (p_new[j] - p_obs[j]) / dt,
-                                                 s0, s1)
+                w = (p_new[j] - p_obs[j]) / dt
+                _, d = closest_approach_straight(a, u, p_obs[j], w, s0, s1)
                 c = d - r - radii[j]
                 if c < step_clear:
                     step_clear = c
                 if c < -COLLISION_EPS and hit is None:
                     hit = o.name
+                    if collision_with is None:
+                        tc = disc_contact(a, u, p_obs[j], w, r + radii[j], s0, s1)
+                        pc, q = a + u * tc, p_obs[j] + w * tc
+                        approach, caused = approach_speed(u, pc, q), robot_caused(u, pc, q)
             p_obs = p_new
         min_clear = min(min_clear, step_clear)
         state, t = new, t_new
@@ -242,6 +272,8 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
     status = "collision" if collided else ("reached" if reached else "timeout")
     if unreachable:
         status = "unreachable"
+    bound = scenario_time_lower_bound(scenario)
+    ttg = time_to_goal if reached else None
     st = AgentStats() if unreachable else agent.stats
     return RunResult(
         scenario=scenario.name,
@@ -264,4 +296,9 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
         dt_s=dt,
         wall_time_s=time.perf_counter() - wall0,
         extra={**st.extra, "perception": sensor.record()},
+        collision_robot_caused=caused if collided else None,
+        collision_approach_speed_mps=approach if collided else None,
+        time_lower_bound_s=bound,
+        time_over_lower_bound=(ttg / bound if ttg is not None and bound is not None and bound > 0.0
+                               else None),
     )
