@@ -56,6 +56,8 @@ class DOVSAgent(Agent):
                                   f"(known: {', '.join(DOVSConfig.field_names())})")
         self.base_config = replace(base, **overrides) if overrides else base
         self.use_robot_limits = use_robot_limits
+        #: Horizon [s] at which a tracked obstacle's uncertain radius is taken.
+        self.uncertainty_horizon_s = 1.0
         self.config = self.base_config
         self.planner: DOVSPlanner | None = None
         self.last_decision: Decision | None = None
@@ -84,7 +86,12 @@ class DOVSAgent(Agent):
         if self.planner is None:
             raise RuntimeError("DOVSAgent.decide called before reset")
         r = obs.robot
-        return self.planner.decide((r.x, r.y, r.theta), (r.v, r.omega), obs.obstacles)
+        # An uncertain (tracked) obstacle enters DOVS's model as a disc grown to its uncertainty
+        # at ``uncertainty_horizon_s`` ahead: DOVS's model takes one radius per obstacle.
+        h = self.uncertainty_horizon_s
+        seen = tuple(o if o.growth is None else replace(o, radius=o.radius + float(o.growth.at(obs.t + h)))
+                     for o in obs.obstacles)
+        return self.planner.decide((r.x, r.y, r.theta), (r.v, r.omega), seen)
 
     def act(self, obs: Observation) -> Command:
         if self._next_t is not None and obs.t < self._next_t - 1e-9:

@@ -133,6 +133,7 @@ class SequentialBITStarAgent(Agent):
         self._failures = 0  # consecutive replannings without a motion
         self._retry_at = -math.inf  # no replanning before this time [s] (back-off)
         self._seen: set[str] = set()
+        self._requested: str | None = None
         self.tracking = TrackingLog()
         ex = self.stats.extra
         ex.update({"statuses": {}, "iterations": [], "late_plans": 0, "plan_time_s": [],
@@ -262,7 +263,8 @@ class SequentialBITStarAgent(Agent):
             if self.pending is not None and t >= self.pending[0] - 1e-9:
                 self.trajectory, self.pending = self.pending[1], None
         elif (self.trajectory is not None and self.pending is None
-              and t - self._last_check >= self.check_period_s - 1e-9):
+              and (t - self._last_check >= self.check_period_s - 1e-9
+                   or self._requested is not None)):
             self._check(obs, preds)
         traj = self.trajectory
         if traj is None:
@@ -271,8 +273,18 @@ class SequentialBITStarAgent(Agent):
         self.tracking.add((x, y), obs.robot, self.stats.extra)
         return self.controller.command(traj, obs.robot, t)
 
+    def request_replan(self, reason: str) -> None:
+        """Replan at the next step (e.g. an obstacle left its predicted tube)."""
+        self._requested = reason
+
     def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
         t = obs.t
+        if self._requested is not None:
+            reason, self._requested = self._requested, None
+            self._last_check = t
+            self._seen |= {p.name for p in preds}
+            self._replan(obs, preds, reason)
+            return
         self._last_check = t
         traj = self.trajectory
         assert traj is not None

@@ -27,6 +27,7 @@ __all__ = [
     "first_contact_straight",
     "closest_approach",
     "first_contact",
+    "first_contact_growing",
 ]
 
 PositionFn = Callable[[np.ndarray], np.ndarray]
@@ -143,6 +144,25 @@ def first_contact(pos_a: PositionFn, pos_b: PositionFn, rel_speed_bound: float, 
         return np.hypot(d[:, 0], d[:, 1])
 
     return _certified_scan(dist, rel_speed_bound, t0, t1, radius, tol)
+
+
+def first_contact_growing(pos_a: PositionFn, pos_b: PositionFn, rel_speed_bound: float,
+                          radius: float, extra_fn: Callable[[np.ndarray], np.ndarray],
+                          extra_rate_bound: float, t0: float, t1: float,
+                          tol: float = 1e-6) -> float | None:
+    """First time in [t0, t1] at which two moving points come within ``radius + extra_fn(t)``
+    (a contact distance that changes with time, e.g. an uncertain disc growing with the horizon),
+    or None.
+
+    The search scans ``dist(t) - extra_fn(t)``, whose slope is bounded by
+    ``rel_speed_bound + extra_rate_bound`` (a bound on |d extra / dt| [m/s]); otherwise as
+    :func:`first_contact`: within ``tol`` and never later than the true first contact.
+    """
+    def gap(t: np.ndarray) -> np.ndarray:
+        d = pos_a(t) - pos_b(t)
+        return np.hypot(d[:, 0], d[:, 1]) - extra_fn(t)
+
+    return _certified_scan(gap, rel_speed_bound + extra_rate_bound, t0, t1, radius, tol)
 
 
 def closest_approach(pos_a: PositionFn, pos_b: PositionFn, rel_speed_bound: float, t0: float,

@@ -10,7 +10,47 @@ import numpy as np
 
 from anyplan.world.motion import Motion, UnicycleMotion
 
-__all__ = ["ObstacleObservation", "PredictedObstacle", "Predictor", "ConstantTwistPredictor"]
+__all__ = ["ObstacleObservation", "PredictedObstacle", "Predictor", "ConstantTwistPredictor",
+           "RadiusGrowth"]
+
+
+@dataclass(frozen=True)
+class RadiusGrowth:
+    """Extra radius [m] of an uncertain prediction as a function of the horizon.
+
+    ``extra(t) = interp(t - t0, taus, values)``: piecewise linear in the horizon ``t - t0`` [s],
+    nondecreasing, constant before the first and after the last knot (the horizon cap). Its
+    slope never exceeds :attr:`rate` [m/s], which certified contact searches add to the relative
+    speed bound, so that they stay exact for the growing disc.
+    """
+
+    t0: float
+    taus: np.ndarray
+    values: np.ndarray
+
+    def __post_init__(self) -> None:
+        k = np.asarray(self.taus, dtype=float)
+        v = np.maximum.accumulate(np.maximum(np.asarray(self.values, dtype=float), 0.0))
+        if k.ndim != 1 or len(k) != len(v) or len(k) < 1 or np.any(np.diff(k) <= 0.0):
+            raise ValueError("taus must be increasing and as long as values")
+        object.__setattr__(self, "taus", k)
+        object.__setattr__(self, "values", v)
+
+    def at(self, t: np.ndarray | float) -> np.ndarray:
+        """Extra radius [m] at absolute times ``t`` [s]."""
+        return np.interp(np.asarray(t, dtype=float) - self.t0, self.taus, self.values)
+
+    @property
+    def rate(self) -> float:
+        """Upper bound on d extra / dt [m/s]."""
+        if len(self.taus) < 2:
+            return 0.0
+        return float(max(np.max(np.diff(self.values) / np.diff(self.taus)), 0.0))
+
+    @property
+    def max_extra(self) -> float:
+        """The largest extra radius [m] (at the horizon cap)."""
+        return float(self.values[-1])
 
 
 @dataclass(frozen=True)
@@ -27,6 +67,8 @@ class ObstacleObservation:
         radius: Disc radius [m].
         motion: The obstacle's announced motion model over time, when it is known in full
             (e.g. a published track); None when only the current twist is known.
+        growth: For an estimated obstacle (tracked from noisy detections), the extra radius of
+            its prediction as a function of the horizon; None when the pose is exact.
     """
 
     name: str
@@ -38,15 +80,33 @@ class ObstacleObservation:
     omega: float
     radius: float
     motion: Motion | None = None
+    growth: RadiusGrowth | None = None
 
 
 @dataclass(frozen=True)
 class PredictedObstacle:
-    """A predicted moving disc: ``motion.positions(t)`` for absolute times t [s]."""
+    """A predicted moving disc: ``motion.positions(t)`` for absolute times t [s].
+
+    With ``growth``, the disc's radius at time t is ``radius + growth.at(t)`` (an uncertain
+    prediction whose disc grows with the horizon, up to a cap); the certified collision checks
+    (:mod:`anyplan.prediction.collision`) honour it exactly.
+    """
 
     name: str
     radius: float
     motion: Motion
+    growth: RadiusGrowth | None = None
+
+    def radius_at(self, t: np.ndarray | float) -> np.ndarray | float:
+        """Disc radius [m] at absolute times ``t`` [s]."""
+        if self.growth is None:
+            return self.radius if np.ndim(t) == 0 else np.full(np.shape(t), self.radius)
+        return self.radius + self.growth.at(t)
+
+    @property
+    def max_radius(self) -> float:
+        """The largest radius [m] the disc reaches."""
+        return self.radius + (0.0 if self.growth is None else self.growth.max_extra)
 
     def positions(self, t: np.ndarray) -> np.ndarray:
         """Predicted centres at times ``t`` (N,) [s], shape (N, 2) [m]."""
@@ -85,7 +145,7 @@ class ConstantTwistPredictor:
                 motion: Motion = o.motion
             else:
                 motion = _shifted_unicycle(o)
-            out.append(PredictedObstacle(o.name, o.radius, motion))
+            out.append(PredictedObstacle(o.name, o.radius, motion, o.growth))
         return out
 
 

@@ -6,7 +6,10 @@ The robot's motion is any object with ``positions(t)`` (absolute times [s] -> (N
 :class:`~anyplan.prediction.base.PredictedObstacle`. The first contact time is found by the
 certified search of :func:`anyplan.geometry.first_contact`, which uses the bound on the relative
 speed so that no contact can slip between evaluation points: the time returned is exact up to
-``tol`` and never later than the true first contact.
+``tol`` and never later than the true first contact. An obstacle whose radius grows with the
+horizon (``PredictedObstacle.growth``, an uncertain prediction) is searched with its growing
+radius and the growth rate added to the speed bound
+(:func:`anyplan.geometry.moving.first_contact_growing`): exact for the growing disc too.
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ from typing import Protocol
 
 import numpy as np
 
-from anyplan.geometry.moving import first_contact
+from anyplan.geometry.moving import first_contact, first_contact_growing
 from anyplan.prediction.base import PredictedObstacle
 
 __all__ = ["TimedMotion", "SampledMotion", "PredictedCollision", "first_collision",
@@ -88,7 +91,7 @@ class PredictedCollision:
         t: Time of first contact [s] (distance = robot radius + obstacle radius + margin).
         robot_position: Robot reference position at ``t`` [m], shape (2,).
         obstacle_position: Obstacle centre at ``t`` [m], shape (2,).
-        obstacle_radius: [m].
+        obstacle_radius: [m], at ``t`` (an uncertain prediction's disc grows with the horizon).
     """
 
     obstacle: str
@@ -147,7 +150,11 @@ def _predict(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], robot_
     for k, o in enumerate(obstacles):
         reach = robot_radius + o.radius + margin + extra
         d = np.hypot(*(p - o.positions(grid)).T)
-        lb = 0.5 * (d[:-1] + d[1:] - (vr + o.max_speed) * np.diff(grid))
+        rate = 0.0
+        if o.growth is not None:  # the gap to the grown disc; its slope adds the growth rate
+            d = d - o.growth.at(grid)
+            rate = o.growth.rate
+        lb = 0.5 * (d[:-1] + d[1:] - (vr + o.max_speed + rate) * np.diff(grid))
         bad = np.flatnonzero(lb <= reach)
         if len(bad):
             starts.append((float(grid[bad[0]]), k))
@@ -157,11 +164,16 @@ def _predict(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], robot_
             break  # no later candidate can come before the contact already found
         o = obstacles[k]
         reach = robot_radius + o.radius + margin + extra
-        tc = first_contact(motion.positions, o.positions, vr + o.max_speed, reach, ts, t1, tol=tol)
+        if o.growth is None:
+            tc = first_contact(motion.positions, o.positions, vr + o.max_speed, reach, ts, t1, tol=tol)
+        else:
+            tc = first_contact_growing(motion.positions, o.positions, vr + o.max_speed, reach,
+                                       o.growth.at, o.growth.rate, ts, t1, tol=tol)
         if tc is None:
             continue
         ta = np.array([tc])
-        hit = PredictedCollision(o.name, float(tc), motion.positions(ta)[0], o.positions(ta)[0], o.radius)
+        hit = PredictedCollision(o.name, float(tc), motion.positions(ta)[0], o.positions(ta)[0],
+                                 float(o.radius_at(float(tc))))
         out.append(hit)
         out.sort(key=lambda c: c.t)
     return out
@@ -185,6 +197,6 @@ def min_separation(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], 
     p = motion.positions(t)
     best = math.inf
     for o in obstacles:
-        d = np.hypot(*(p - o.positions(t)).T) - robot_radius - o.radius
+        d = np.hypot(*(p - o.positions(t)).T) - robot_radius - o.radius_at(t)
         best = min(best, float(d.min()))
     return best

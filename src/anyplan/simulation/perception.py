@@ -27,6 +27,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from anyplan.agents.base import Agent
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.prediction.detection import Detection
@@ -34,7 +35,8 @@ from anyplan.world.robot import RobotState
 from anyplan.world.scenario import Scenario
 from anyplan.world.sensing import SensingSpec
 
-__all__ = ["NOISE_STREAM", "Sensor", "observe_exact", "effective_sensing", "override_sensing"]
+__all__ = ["NOISE_STREAM", "Sensor", "observe_exact", "effective_sensing", "override_sensing",
+           "with_tracking"]
 
 #: Second entry of the noise generator's seed sequence ``(run seed, NOISE_STREAM)``.
 NOISE_STREAM = 0x5E45
@@ -144,3 +146,16 @@ def override_sensing(scenario: Scenario, mode: str | None = None, noise_m: float
                        base.noise_m if noise_m is None else float(noise_m),
                        base.rate_hz if rate_hz is None else float(rate_hz))
     return replace(scenario, sensing=spec)
+
+
+def with_tracking(agent: Agent, spec: SensingSpec) -> Agent:
+    """``agent`` behind the tracking front end (:class:`~anyplan.agents.perceiving.TrackingAgent`,
+    its tracker told the sensor's noise) when ``spec`` is ``tracked``, unless the agent handles
+    detections itself (``agent.handles_detections``) or is wrapped already."""
+    from anyplan.agents.perceiving import TrackingAgent
+    from anyplan.prediction.tracking import TrackerConfig
+
+    if spec.mode != "tracked" or getattr(agent, "handles_detections", False) \
+            or isinstance(agent, TrackingAgent):
+        return agent
+    return TrackingAgent(agent, TrackerConfig(sigma_m=spec.noise_m))

@@ -41,7 +41,8 @@ from anyplan.simulation.contact import (
     static_contact,
 )
 from anyplan.simulation.feasibility import goal_unreachable
-from anyplan.simulation.perception import Sensor, effective_sensing, observe_exact
+from anyplan.simulation.metrics import moving_obstacle_metrics
+from anyplan.simulation.perception import Sensor, effective_sensing, observe_exact, with_tracking
 from anyplan.world.limits import MAX_SIM_STEPS, MAX_TIME_LIMIT_S, MIN_DT_S
 from anyplan.world.robot import RobotState, step
 from anyplan.world.scenario import Scenario
@@ -129,6 +130,10 @@ class RunResult:
     collision_approach_speed_mps: float | None = None
     time_lower_bound_s: float | None = None
     time_over_lower_bound: float | None = None
+    #: Smallest robot-to-moving-obstacle surface distance [m] (None without moving obstacles)
+    #: and time [s] within 0.2 m of one (:mod:`anyplan.simulation.metrics`).
+    min_distance_to_moving_m: float | None = None
+    discomfort_time_s: float = 0.0
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-serialisable dictionary."""
@@ -184,6 +189,7 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
     movers = scenario.moving_obstacles
     wall0 = time.perf_counter()
     sensor = Sensor(scenario, effective_sensing(scenario, cfg.announce_motions), seed)
+    agent = with_tracking(agent, sensor.spec)
     unreachable = cfg.check_feasibility and goal_unreachable(scenario)
     if unreachable:
         n_max = 0  # nothing to simulate
@@ -301,4 +307,5 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
         time_lower_bound_s=bound,
         time_over_lower_bound=(ttg / bound if ttg is not None and bound is not None and bound > 0.0
                                else None),
+        **moving_obstacle_metrics(scenario, np.asarray(traj)),
     )

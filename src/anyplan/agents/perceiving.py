@@ -1,0 +1,104 @@
+"""The robot's tracking front end: noisy detections in, estimated obstacles out, for any agent.
+
+With ``tracked`` perception the simulator hands agents only
+:class:`~anyplan.prediction.detection.Detection` records. :class:`TrackingAgent` wraps any agent:
+at every step it feeds the detections to an IMM tracker
+(:class:`~anyplan.prediction.tracking.Tracker`) and gives the inner agent an
+:class:`~anyplan.agents.base.Observation` whose obstacles are the tracks' estimates (pose and
+twist of the mean, no motion model) carrying the growth of their uncertain disc
+(:class:`~anyplan.prediction.uncertain.UncertaintyModel`). Every planner therefore plans against
+the same uncertain predictions, through its usual predictor.
+
+**Leaving the tube.** When the inner agent plans (its count of planning calls grows), the wrapper
+keeps the predictions it planned against. A later detection farther from its predicted centre
+than the grown radius plus three noise standard deviations has left the predicted tube: the
+wrapper asks the inner agent to replan (``request_replan(reason)``, if it has one) and counts it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from anyplan.agents.base import Agent, AgentStats, Observation
+from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
+from anyplan.prediction.tracking import Tracker, TrackerConfig
+from anyplan.prediction.uncertain import UncertaintyModel
+from anyplan.world.robot import Command
+from anyplan.world.scenario import Scenario
+
+__all__ = ["TrackingAgent"]
+
+
+class TrackingAgent(Agent):
+    """Any agent behind a tracker.
+
+    Args:
+        inner: The agent to drive.
+        tracker: Tracker settings (``sigma_m`` should be the sensor's noise).
+        uncertainty: How covariances become growing discs.
+    """
+
+    def __init__(self, inner: Agent, tracker: TrackerConfig | None = None,
+                 uncertainty: UncertaintyModel | None = None) -> None:
+        self.inner = inner
+        self.tracker_config = tracker or TrackerConfig()
+        self.uncertainty = uncertainty or UncertaintyModel()
+        self.tracker = Tracker(self.tracker_config)
+        self._tube: dict[str, PredictedObstacle] = {}
+        self._plans = 0
+        self.tube_exits = 0
+
+    @property  # type: ignore[override]
+    def name(self) -> str:
+        return self.inner.name
+
+    @property  # type: ignore[override]
+    def stats(self) -> AgentStats:
+        return self.inner.stats
+
+    @stats.setter
+    def stats(self, value: AgentStats) -> None:
+        self.inner.stats = value
+
+    def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
+        self.inner.reset(scenario, rng)
+        self.tracker = Tracker(self.tracker_config)
+        self._tube = {}
+        self._plans = 0
+        self.tube_exits = 0
+        self._predictor = ConstantTwistPredictor(use_announced=False)
+
+    def _check_tube(self, obs: Observation) -> str | None:
+        k = 3.0 * max(self.tracker_config.sigma_m, 1e-3)
+        for d in obs.detections:
+            p = self._tube.get(d.name)
+            if p is None:
+                continue
+            c = p.positions(np.array([d.t]))[0]
+            if math.hypot(d.x - c[0], d.y - c[1]) > float(p.radius_at(d.t)) - p.radius + k:
+                return d.name
+        return None
+
+    def act(self, obs: Observation) -> Command:
+        self.tracker.update(obs.t, obs.detections)
+        seen = self.uncertainty.observations(self.tracker.estimates(obs.t))
+        left = self._check_tube(obs) if self._tube else None
+        if left is not None:
+            self.tube_exits += 1
+            self._tube = {}  # one request per plan
+            req = getattr(self.inner, "request_replan", None)
+            if req is not None:
+                req(f"{left} left its predicted tube")
+        inner_obs = Observation(obs.t, obs.robot, seen + tuple(obs.obstacles), ())
+        cmd = self.inner.act(inner_obs)
+        n = len(self.inner.stats.planning_times_s)
+        if n != self._plans:
+            self._plans = n
+            self._tube = {p.name: p for p in self._predictor.predict(seen)}
+        ex: dict[str, Any] = self.inner.stats.extra
+        ex["tracking"] = {"tracks": len(self.tracker), "dropped": self.tracker.dropped,
+                          "tube_exits": self.tube_exits}
+        return cmd

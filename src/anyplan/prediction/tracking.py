@@ -1,0 +1,272 @@
+"""Tracking moving obstacles from noisy position detections: an IMM of two Kalman filters.
+
+Each obstacle (by name: the association is given) has a state ``[x, y, vx, vy, omega]``
+(m, m/s, rad/s) estimated by an interacting multiple model (IMM; Blom & Bar-Shalom 1988) of
+
+* **CV**, constant velocity: ``p' = p + v T``, ``v' = v``, with white-noise acceleration of
+  spectral density ``q_cv`` [m^2/s^3]; its turn rate is reset to 0 (``omega' = 0``);
+* **CT**, coordinated turn at the unknown rate omega (an extended Kalman filter: the velocity
+  turns by ``omega T``, ``p' = p + [[s, -(1-c)], [1-c, s]] v / omega``), white-noise acceleration
+  ``q_ct`` and a random walk of omega (``q_omega`` [rad^2/s^3]).
+
+Both models share the state, so mixing is the plain IMM moment matching. The models switch with
+rate ``switch_rate`` [1/s]. Measurements are positions with noise ``sigma_m`` [m] per axis.
+
+* **Appearing**: a new name starts a track at its detection, at rest with a velocity standard
+  deviation ``init_speed_sigma`` [m/s].
+* **Occluded**: no detection in a frame, the track *coasts*: it is predicted (covariance growing).
+* **Leaving**: a track not detected for ``drop_after_s`` seconds is dropped.
+
+Everything is vectorised over tracks (arrays of shape (N, 2, 5) and (N, 2, 5, 5)).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from anyplan.prediction.detection import Detection
+
+__all__ = ["TrackerConfig", "Tracker", "TrackEstimate", "ct_transition"]
+
+_H = np.zeros((2, 5))
+_H[0, 0] = _H[1, 1] = 1.0
+
+
+@dataclass(frozen=True)
+class TrackerConfig:
+    """Tracker settings (SI units).
+
+    Attributes:
+        sigma_m: Measurement noise [m] per axis (the sensor's); floored at 1 mm.
+        q_cv: Acceleration noise density of the CV model [m^2/s^3].
+        q_ct: Acceleration noise density of the CT model [m^2/s^3].
+        q_omega: Turn-rate random walk density of the CT model [rad^2/s^3].
+        switch_rate: Model switching rate [1/s].
+        init_speed_sigma: Velocity standard deviation [m/s] of a new track.
+        drop_after_s: A track not detected for this long [s] is dropped.
+    """
+
+    sigma_m: float = 0.05
+    q_cv: float = 0.05
+    q_ct: float = 0.05
+    q_omega: float = 0.02
+    switch_rate: float = 0.5
+    init_speed_sigma: float = 1.0
+    drop_after_s: float = 2.0
+
+
+@dataclass(frozen=True)
+class TrackEstimate:
+    """One track at time ``t`` [s]: mean state, its covariance and the model probabilities.
+
+    Attributes:
+        name: Obstacle name.
+        t: Time [s] of the estimate.
+        state: ``[x, y, vx, vy, omega]`` (m, m/s, rad/s).
+        cov: 5 x 5 covariance.
+        mode_probs: (P(CV), P(CT)).
+        radius: Disc radius [m] from the detections.
+        last_seen: Time [s] of the last detection.
+        n_updates: Number of detections used.
+        model_states: The two models' states (2, 5): CV, CT.
+    """
+
+    name: str
+    t: float
+    state: np.ndarray
+    cov: np.ndarray
+    mode_probs: np.ndarray
+    radius: float
+    last_seen: float
+    n_updates: int
+    model_states: np.ndarray | None = None
+
+    @property
+    def turn_rate(self) -> float:
+        """The CT model's turn rate [rad/s] (the mixture's omega is diluted by CV's zero)."""
+        return float(self.model_states[1, 4]) if self.model_states is not None else float(self.state[4])
+
+    @property
+    def speed(self) -> float:
+        """Estimated speed [m/s]."""
+        return float(math.hypot(self.state[2], self.state[3]))
+
+    @property
+    def heading(self) -> float:
+        """Estimated heading [rad] (of the velocity)."""
+        return float(math.atan2(self.state[3], self.state[2]))
+
+
+def ct_transition(x: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Coordinated-turn step of states ``x`` (N, 5) by ``T`` (N,) [s]: (new states, Jacobians
+    (N, 5, 5)). Stable as omega -> 0 (series below |omega T| = 1e-4)."""
+    vx, vy, w = x[:, 2], x[:, 3], x[:, 4]
+    wt = w * T
+    s, c = np.sin(wt), np.cos(wt)
+    small = np.abs(wt) < 1e-4
+    ws = np.where(small, 1.0, w)
+    A = np.where(small, T - w * w * T ** 3 / 6.0, s / ws)            # sin(wT) / w
+    B = np.where(small, w * T * T / 2.0, (1.0 - c) / ws)             # (1 - cos wT) / w
+    dA = np.where(small, -w * T ** 3 / 3.0, (T * c * ws - s) / (ws * ws))
+    dB = np.where(small, T * T / 2.0 - w * w * T ** 4 / 8.0, (T * s * ws - (1.0 - c)) / (ws * ws))
+    out = np.empty_like(x)
+    out[:, 0] = x[:, 0] + A * vx - B * vy
+    out[:, 1] = x[:, 1] + B * vx + A * vy
+    out[:, 2] = c * vx - s * vy
+    out[:, 3] = s * vx + c * vy
+    out[:, 4] = w
+    F = np.zeros((len(x), 5, 5))
+    F[:, 0, 0] = F[:, 1, 1] = F[:, 4, 4] = 1.0
+    F[:, 0, 2], F[:, 0, 3], F[:, 0, 4] = A, -B, dA * vx - dB * vy
+    F[:, 1, 2], F[:, 1, 3], F[:, 1, 4] = B, A, dB * vx + dA * vy
+    F[:, 2, 2], F[:, 2, 3], F[:, 2, 4] = c, -s, -T * (s * vx + c * vy)
+    F[:, 3, 2], F[:, 3, 3], F[:, 3, 4] = s, c, T * (c * vx - s * vy)
+    return out, F
+
+
+def _accel_q(T: np.ndarray, q: float) -> np.ndarray:
+    """Discrete white-noise-acceleration covariance (N, 5, 5) on [x, y, vx, vy]."""
+    Q = np.zeros((len(T), 5, 5))
+    for i in (0, 1):
+        Q[:, i, i] = q * T ** 3 / 3.0
+        Q[:, i, i + 2] = Q[:, i + 2, i] = q * T ** 2 / 2.0
+        Q[:, i + 2, i + 2] = q * T
+    return Q
+
+
+class Tracker:
+    """IMM (CV + CT) tracks of named obstacles.
+
+    Args:
+        config: Filter settings.
+    """
+
+    def __init__(self, config: TrackerConfig | None = None) -> None:
+        self.config = config or TrackerConfig()
+        self.names: list[str] = []
+        self.x = np.zeros((0, 2, 5))
+        self.P = np.zeros((0, 2, 5, 5))
+        self.mu = np.zeros((0, 2))
+        self.t = np.zeros(0)          # filter time of each track [s]
+        self.last_seen = np.zeros(0)  # time of the last detection [s]
+        self.radius = np.zeros(0)
+        self.n = np.zeros(0, dtype=int)
+        self.dropped = 0
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    # --- filter steps ----------------------------------------------------------------------------
+    def _predict(self, idx: np.ndarray, t: float) -> None:
+        """IMM mixing and prediction of tracks ``idx`` to time ``t``."""
+        if len(idx) == 0:
+            return
+        cfg = self.config
+        T = np.maximum(t - self.t[idx], 0.0)
+        x, P, mu = self.x[idx], self.P[idx], self.mu[idx]
+        p_sw = 1.0 - np.exp(-cfg.switch_rate * T)
+        trans = np.empty((len(idx), 2, 2))              # trans[n, i, j] = P(j | i)
+        trans[:, 0, 0] = trans[:, 1, 1] = 1.0 - p_sw
+        trans[:, 0, 1] = trans[:, 1, 0] = p_sw
+        c = np.einsum("ni,nij->nj", mu, trans)           # predicted model probabilities
+        w = mu[:, :, None] * trans / np.maximum(c[:, None, :], 1e-300)  # w[n, i, j] = mu_{i|j}
+        x0 = np.einsum("nij,nik->njk", w, x)
+        d = x[:, :, None, :] - x0[:, None, :, :]         # [n, i, j, k]
+        P0 = np.einsum("nij,nikl->njkl", w, P) + np.einsum("nij,nijk,nijl->njkl", w, d, d)
+        # CV (model 0): omega reset to 0
+        F = np.zeros((len(idx), 5, 5))
+        F[:, 0, 0] = F[:, 1, 1] = F[:, 2, 2] = F[:, 3, 3] = 1.0
+        F[:, 0, 2] = F[:, 1, 3] = T
+        xcv = np.einsum("nkl,nl->nk", F, x0[:, 0])
+        Qcv = _accel_q(T, cfg.q_cv)
+        Qcv[:, 4, 4] = 1e-6
+        Pcv = np.einsum("nab,nbc,ndc->nad", F, P0[:, 0], F) + Qcv
+        xct, Fct = ct_transition(x0[:, 1], T)
+        Qct = _accel_q(T, cfg.q_ct)
+        Qct[:, 4, 4] = cfg.q_omega * T
+        Pct = np.einsum("nab,nbc,ndc->nad", Fct, P0[:, 1], Fct) + Qct
+        self.x[idx, 0], self.x[idx, 1] = xcv, xct
+        self.P[idx, 0], self.P[idx, 1] = Pcv, Pct
+        self.mu[idx] = c
+        self.t[idx] = t
+
+    def _update(self, idx: np.ndarray, z: np.ndarray) -> None:
+        """Kalman update of tracks ``idx`` (already at the detection time) with positions z (N, 2)."""
+        r2 = max(self.config.sigma_m, 1e-3) ** 2
+        x, P = self.x[idx], self.P[idx]
+        y = z[:, None, :] - x[:, :, :2]                   # innovation (n, m, 2)
+        S = P[:, :, :2, :2] + r2 * np.eye(2)
+        Sinv = np.linalg.inv(S)
+        K = np.einsum("nmab,nmbc->nmac", P[:, :, :, :2], Sinv)   # (n, m, 5, 2)
+        x = x + np.einsum("nmab,nmb->nma", K, y)
+        P = P - np.einsum("nmab,nmbc->nmac", K, P[:, :, :2, :])
+        P = 0.5 * (P + np.swapaxes(P, -1, -2))
+        md = np.einsum("nma,nmab,nmb->nm", y, Sinv, y)
+        lik = np.exp(-0.5 * np.minimum(md, 700.0)) / (2 * math.pi * np.sqrt(np.linalg.det(S)))
+        mu = self.mu[idx] * (lik + 1e-300)
+        self.mu[idx] = mu / mu.sum(axis=1, keepdims=True)
+        self.x[idx], self.P[idx] = x, P
+
+    def _add(self, d: Detection) -> None:
+        cfg = self.config
+        r2 = max(cfg.sigma_m, 1e-3) ** 2
+        x = np.array([d.x, d.y, 0.0, 0.0, 0.0])
+        P = np.diag([r2, r2, cfg.init_speed_sigma ** 2, cfg.init_speed_sigma ** 2, 0.3 ** 2])
+        self.names.append(d.name)
+        self.x = np.concatenate([self.x, np.broadcast_to(x, (1, 2, 5))])
+        self.P = np.concatenate([self.P, np.broadcast_to(P, (1, 2, 5, 5))])
+        self.mu = np.concatenate([self.mu, [[0.8, 0.2]]])
+        self.t = np.append(self.t, d.t)
+        self.last_seen = np.append(self.last_seen, d.t)
+        self.radius = np.append(self.radius, d.radius)
+        self.n = np.append(self.n, 1)
+
+    def _drop(self, keep: np.ndarray) -> None:
+        self.dropped += int((~keep).sum())
+        self.names = [n for n, k in zip(self.names, keep, strict=True) if k]
+        self.x, self.P, self.mu = self.x[keep], self.P[keep], self.mu[keep]
+        self.t, self.last_seen = self.t[keep], self.last_seen[keep]
+        self.radius, self.n = self.radius[keep], self.n[keep]
+
+    # --- public ----------------------------------------------------------------------------------
+    def update(self, t: float, detections: Iterable[Detection]) -> None:
+        """One sensor frame at time ``t`` [s]: update the detected tracks, start new ones,
+        coast the others and drop those unseen for ``drop_after_s``."""
+        dets = list(detections)
+        index = {n: i for i, n in enumerate(self.names)}
+        upd = [(index[d.name], d) for d in dets if d.name in index]
+        new = [d for d in dets if d.name not in index]
+        if upd:
+            idx = np.array([i for i, _ in upd])
+            self._predict(idx, t)
+            self._update(idx, np.array([[d.x, d.y] for _, d in upd]))
+            self.last_seen[idx] = t
+            self.n[idx] += 1
+            self.radius[idx] = [d.radius for _, d in upd]
+        for d in new:
+            self._add(d)
+        keep = t - self.last_seen <= self.config.drop_after_s + 1e-9
+        if not keep.all():
+            self._drop(keep)
+
+    def estimates(self, t: float) -> list[TrackEstimate]:
+        """Every track predicted to time ``t`` [s] (the filter itself is not changed): the IMM
+        combination of the models' means and covariances."""
+        if not self.names:
+            return []
+        saved = (self.x.copy(), self.P.copy(), self.mu.copy(), self.t.copy())
+        idx = np.flatnonzero(self.t < t)
+        self._predict(idx, t)
+        mu = self.mu
+        xm = np.einsum("nm,nmk->nk", mu, self.x)
+        d = self.x - xm[:, None, :]
+        Pm = np.einsum("nm,nmkl->nkl", mu, self.P) + np.einsum("nm,nmk,nml->nkl", mu, d, d)
+        out = [TrackEstimate(n, t, xm[i], Pm[i], mu[i].copy(), float(self.radius[i]),
+                             float(self.last_seen[i]), int(self.n[i]), self.x[i].copy())
+               for i, n in enumerate(self.names)]
+        self.x, self.P, self.mu, self.t = saved
+        return out

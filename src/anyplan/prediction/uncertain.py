@@ -1,0 +1,84 @@
+"""Predictions with uncertainty: tracked obstacles as discs that grow with the horizon.
+
+A track (:class:`~anyplan.prediction.tracking.TrackEstimate`) is predicted along its mean
+motion (a constant twist: speed, heading and turn rate of the IMM estimate, i.e. a line or a
+circle); the turn rate is kept only when the IMM is confident the obstacle turns
+(P(CT) >= ``turn_confidence``, 0.7), since extrapolating a noisy turn rate over seconds is worse
+than a straight line (measured on ETH/UCY, ``benchmarks/unknown.py``). Its disc grows with the horizon tau [s] by
+
+    extra(tau) = min(k * sqrt(lambda_max(Sigma(tau))) + a_m tau^2 / 2, cap),
+
+with ``Sigma(tau) = F(tau) P F(tau)^T`` the position block of the estimate's covariance P
+propagated through the coordinated-turn Jacobian F(tau) (linearised at the mean),
+``a_m`` a manoeuvre allowance [m/s^2] (what the filter cannot foresee: a pedestrian who
+changes her mind) and ``cap`` [m] the largest extra radius; ``extra`` is evaluated at the knots
+:attr:`UncertaintyModel.taus` (up to the horizon cap, constant beyond) and interpolated linearly
+between them (:class:`~anyplan.prediction.base.RadiusGrowth`). For a 2-D Gaussian error the
+k-sigma disc of the largest axis holds the truth with probability at least ``1 - exp(-k^2/2)``
+(86 % for k = 2), before the allowance.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from anyplan.prediction.base import ObstacleObservation, RadiusGrowth
+from anyplan.prediction.tracking import TrackEstimate, ct_transition
+
+__all__ = ["UncertaintyModel"]
+
+
+@dataclass(frozen=True)
+class UncertaintyModel:
+    """How a track's covariance becomes a growing disc.
+
+    Attributes:
+        k_sigma: Standard deviations of the position covered.
+        accel_allowance: Manoeuvre allowance a_m [m/s^2].
+        cap_m: Largest extra radius [m].
+        taus: Horizon knots [s] (increasing, from 0; the last is the horizon cap).
+    """
+
+    k_sigma: float = 2.0
+    accel_allowance: float = 0.1
+    cap_m: float = 1.0
+    taus: tuple[float, ...] = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0)
+    turn_confidence: float = 0.7
+
+    def _means(self, estimates: Sequence[TrackEstimate]) -> np.ndarray:
+        """Mean states (N, 5), the turn rate kept only when P(CT) >= turn_confidence."""
+        x = np.array([e.state for e in estimates]).reshape(-1, 5).copy()
+        turn = np.array([e.mode_probs[1] >= self.turn_confidence for e in estimates], dtype=bool)
+        x[:, 4] = np.where(turn, [e.turn_rate for e in estimates], 0.0)
+        return x
+
+    def extras(self, estimates: Sequence[TrackEstimate]) -> np.ndarray:
+        """Extra radii [m] at the knots, shape (N, K)."""
+        n, taus = len(estimates), np.asarray(self.taus, dtype=float)
+        if n == 0:
+            return np.zeros((0, len(taus)))
+        x = np.repeat(self._means(estimates), len(taus), axis=0)
+        P = np.repeat(np.array([e.cov for e in estimates]), len(taus), axis=0)
+        T = np.tile(taus, n)
+        _, F = ct_transition(x, T)
+        S = np.einsum("nab,nbc,ndc->nad", F[:, :2, :], P, F[:, :2, :])
+        # largest eigenvalue of a symmetric 2 x 2 matrix, in closed form
+        a, b, c = S[:, 0, 0], S[:, 0, 1], S[:, 1, 1]
+        lam = 0.5 * (a + c) + np.sqrt(np.maximum(0.25 * (a - c) ** 2 + b * b, 0.0))
+        e = self.k_sigma * np.sqrt(np.maximum(lam, 0.0)) + 0.5 * self.accel_allowance * T * T
+        return np.minimum(e, self.cap_m).reshape(n, len(taus))
+
+    def observations(self, estimates: Sequence[TrackEstimate]) -> tuple[ObstacleObservation, ...]:
+        """The estimates as observations (pose and twist of the mean) carrying their growth."""
+        ex = self.extras(estimates)
+        taus = np.asarray(self.taus, dtype=float)
+        means = self._means(estimates)
+        out = []
+        for e, x, row in zip(estimates, means, ex, strict=True):
+            out.append(ObstacleObservation(e.name, e.t, float(x[0]), float(x[1]), e.heading,
+                                           e.speed, float(x[4]), e.radius, None,
+                                           RadiusGrowth(e.t, taus, row)))
+        return tuple(out)

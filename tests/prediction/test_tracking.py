@@ -1,0 +1,123 @@
+"""The IMM tracker: convergence on straight and turning motion, consistency, appearing,
+coasting through occlusions, dropping, and the coordinated-turn Jacobian."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from anyplan.prediction.detection import Detection
+from anyplan.prediction.tracking import Tracker, TrackerConfig, ct_transition
+
+
+def _circle(t, v, w):
+    if w == 0.0:
+        return np.array([1.0 + v * t, 2.0 + 0.5 * v * t]), np.array([v, 0.5 * v])
+    return (np.array([v / w * np.sin(w * t), v / w * (1 - np.cos(w * t))]),
+            np.array([v * np.cos(w * t), v * np.sin(w * t)]))
+
+
+def _run(v, w, seed, secs=8.0, sigma=0.05, rate=10.0):
+    rng = np.random.default_rng(seed)
+    tr = Tracker(TrackerConfig(sigma_m=sigma))
+    t = 0.0
+    for k in range(int(secs * rate) + 1):
+        t = k / rate
+        p, _ = _circle(t, v, w)
+        z = p + rng.normal(0.0, sigma, 2)
+        tr.update(t, [Detection("a", t, float(z[0]), float(z[1]), 0.3)])
+    return tr, t
+
+
+def test_converges_on_straight_motion_with_a_covariance_that_does_not_understate_the_error():
+    errs, nees = [], []
+    for seed in range(30):
+        tr, t = _run(1.2, 0.0, seed)
+        e = tr.estimates(t)[0]
+        p, vel = _circle(t, 1.2, 0.0)
+        d = np.concatenate([e.state[:2] - p, e.state[2:4] - vel])
+        errs.append(np.linalg.norm(e.state[2:4] - vel))
+        nees.append(d @ np.linalg.solve(e.cov[:4, :4], d))
+        assert abs(e.state[4]) < 0.2
+    assert np.median(errs) < 0.1  # m/s
+    # not overconfident: the mean NEES of the 4-D error stays below 4 (its value for an exact
+    # covariance); the process noise makes it conservative on a perfectly straight motion
+    assert np.mean(nees) < 4.0
+
+
+def test_converges_on_turning_motion_and_detects_the_turn():
+    ws, probs = [], []
+    for seed in range(10):
+        tr, t = _run(1.2, 0.5, seed)
+        e = tr.estimates(t)[0]
+        p, vel = _circle(t, 1.2, 0.5)
+        assert np.linalg.norm(e.state[:2] - p) < 0.1
+        assert np.linalg.norm(e.state[2:4] - vel) < 0.2
+        ws.append(e.turn_rate)
+        probs.append(e.mode_probs[1])
+    assert abs(np.median(ws) - 0.5) < 0.08
+    assert np.median(probs) > 0.7  # the CT model dominates (UncertaintyModel.turn_confidence)
+    # and on the straight motion it does not
+    tr, t = _run(1.2, 0.0, 0)
+    assert tr.estimates(t)[0].mode_probs[1] < 0.7
+
+
+def test_appearing_coasting_and_leaving():
+    cfg = TrackerConfig(sigma_m=0.05, drop_after_s=1.5)
+    tr = Tracker(cfg)
+    tr.update(0.0, [Detection("a", 0.0, 0.0, 0.0, 0.3)])
+    assert len(tr) == 1
+    for k in range(1, 21):
+        t = 0.1 * k
+        tr.update(t, [Detection("a", t, t, 0.0, 0.3), Detection("b", t, 5.0, t, 0.4)] if k >= 10
+                  else [Detection("a", t, t, 0.0, 0.3)])
+    assert len(tr) == 2  # b appeared
+    est = {e.name: e for e in tr.estimates(2.0)}
+    assert est["b"].radius == 0.4 and est["b"].n_updates == 11
+    # a is occluded from t = 2.0 on: it coasts, its position covariance grows, its mean moves on
+    traces, xs = [], []
+    for k in range(21, 36):
+        t = 0.1 * k
+        tr.update(t, [Detection("b", t, 5.0, t, 0.4)])
+        a = {e.name: e for e in tr.estimates(t)}.get("a")
+        if a is None:
+            break
+        traces.append(np.trace(a.cov[:2, :2]))
+        xs.append(a.state[0])
+    assert len(traces) == 15 and np.all(np.diff(traces) > 0.0)
+    assert xs[-1] == pytest.approx(3.5, abs=0.2)  # extrapolated at 1 m/s
+    # 1.5 s after its last detection (t = 2.0) it is dropped
+    tr.update(3.55, [Detection("b", 3.55, 5.0, 3.55, 0.4)])
+    assert [e.name for e in tr.estimates(3.55)] == ["b"] and tr.dropped == 1
+    # when it comes back it is a new track
+    tr.update(3.6, [Detection("a", 3.6, 3.6, 0.0, 0.3)])
+    assert {e.name: e.n_updates for e in tr.estimates(3.6)}["a"] == 1
+
+
+def test_estimates_do_not_change_the_filter():
+    tr, t = _run(1.0, 0.0, 0, secs=2.0)
+    before = tr.x.copy(), tr.P.copy()
+    tr.estimates(t + 1.0)
+    assert np.array_equal(before[0], tr.x) and np.array_equal(before[1], tr.P)
+
+
+@pytest.mark.parametrize("w", [0.7, -1.3, 1e-7, 0.0])
+def test_ct_jacobian_matches_finite_differences(w):
+    x = np.array([[1.0, 2.0, 0.7, -0.3, w]])
+    T = np.array([0.4])
+    f, F = ct_transition(x, T)
+    J = np.zeros((5, 5))
+    h = 1e-6
+    for k in range(5):
+        e = np.zeros(5)
+        e[k] = h
+        J[:, k] = (ct_transition(x + e, T)[0][0] - ct_transition(x - e, T)[0][0]) / (2 * h)
+    np.testing.assert_allclose(F[0], J, atol=1e-7)
+    # the transition is the exact unicycle motion
+    v, th = np.hypot(0.7, -0.3), np.arctan2(-0.3, 0.7)
+    if abs(w) > 1e-3:
+        exp = [1.0 + v / w * (np.sin(th + w * 0.4) - np.sin(th)),
+               2.0 - v / w * (np.cos(th + w * 0.4) - np.cos(th))]
+    else:
+        exp = [1.0 + 0.7 * 0.4, 2.0 - 0.3 * 0.4]
+    np.testing.assert_allclose(f[0, :2], exp, atol=1e-6)
