@@ -18,9 +18,10 @@ from tests.conftest import small_scenario_dict
 
 
 class Recorder(Agent):
-    """Stands still and records every observation."""
+    """Stands still and records every observation (the raw detections: no tracking front end)."""
 
     name = "recorder"
+    handles_detections = True
 
     def reset(self, scenario, rng):
         self.log = []
