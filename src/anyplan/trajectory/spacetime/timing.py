@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from anyplan.prediction.base import PredictedObstacle
 from anyplan.prediction.collision import PredictedCollision, first_collision
 from anyplan.trajectory.profile import SpeedProfile
 from anyplan.trajectory.spacetime.lattice import VelocityPlan, plan_velocity
@@ -212,14 +213,18 @@ def verify(motion: Any, obstacles: Sequence[Any], robot_radius: float, *, margin
            sample_dt: float | None = 0.02) -> PredictedCollision | None:
     """The first predicted contact of ``motion`` with ``obstacles``, or None (certified).
 
-    Obstacles of constant radius go to :func:`anyplan.prediction.collision.first_collision`;
+    Obstacles of constant radius, and every :class:`~anyplan.prediction.PredictedObstacle`
+    (whose ``growth`` it honours exactly), go to :func:`anyplan.prediction.collision.first_collision`;
     those with a ``radius_at(t)`` (radius growing or shrinking monotonically between samples
     ``0.02`` s apart) to a certified bisection search on the distance minus the radius.
     """
     t0 = motion.t_start if t_from is None else float(t_from)
     t1 = motion.t_end if t_until is None else float(t_until)
-    const = [o for o in obstacles if not callable(getattr(o, "radius_at", None))]
-    grow = [o for o in obstacles if callable(getattr(o, "radius_at", None))]
+    # PredictedObstacle (growing or not) is certified exactly by first_collision itself.
+    const = [o for o in obstacles
+             if isinstance(o, PredictedObstacle) or not callable(getattr(o, "radius_at", None))]
+    grow = [o for o in obstacles
+            if not isinstance(o, PredictedObstacle) and callable(getattr(o, "radius_at", None))]
     hits: list[PredictedCollision] = []
     if const:
         hit = first_collision(motion, const, robot_radius, t_from=t0, t_until=t1, margin=margin,
