@@ -134,6 +134,25 @@ def _mkdir(folder: Path, opt: str) -> None:
                           f"({exc.strerror or exc})") from None
 
 
+def _guarded(fn):  # noqa: ANN001, ANN202
+    """Any OSError of a path test (a name too long, a loop of links...) is an OutputError."""
+    import functools
+
+    @functools.wraps(fn)
+    def wrapper(path, opt, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
+        try:
+            return fn(path, opt, *args, **kwargs)
+        except OutputError:
+            raise
+        except (OSError, ValueError) as exc:  # ValueError: an embedded NUL byte
+            reason = getattr(exc, "strerror", None) or str(exc)
+            raise OutputError(f"{opt} {one_line(path, 120)}: cannot write ({one_line(reason, 80)})") \
+                from None
+
+    return wrapper
+
+
+@_guarded
 def writable_folder(folder: str | Path, opt: str) -> Path:
     """Create ``folder`` if needed and prove a file can be created in it.
 
@@ -147,6 +166,7 @@ def writable_folder(folder: str | Path, opt: str) -> Path:
     return folder
 
 
+@_guarded
 def writable_file(path: str | Path, opt: str, suffixes: tuple[str, ...] | None = None,
                   make_parent: bool = True) -> Path:
     """Prove that ``path`` can be written, without changing an existing file.

@@ -467,7 +467,11 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
     """
     s = str(name_or_path)
     path = Path(s)
-    if path.suffix in (".yaml", ".yml", ".json") or path.exists():
+    try:
+        exists = path.exists()
+    except (OSError, ValueError):  # a name too long, a NUL byte: not a file we can read
+        exists = path.suffix in (".yaml", ".yml", ".json") or len(s) > 255 or "\0" in s
+    if path.suffix in (".yaml", ".yml", ".json") or exists:
         return _from_text(_read_file(path, s), s)
     res = resources.files("anyplan.scenarios").joinpath(f"{s}.yaml")
     if res.is_file():
@@ -487,8 +491,9 @@ def _read_file(path: Path, source: str) -> str:
         st = os.stat(path)
     except FileNotFoundError:
         raise ScenarioError(source, "", "no such file") from None
-    except OSError as exc:
-        raise ScenarioError(source, "", f"cannot read file ({exc.strerror})") from None
+    except (OSError, ValueError) as exc:
+        raise ScenarioError(source, "", f"cannot read file ({getattr(exc, 'strerror', None) or exc})") \
+            from None
     if stat.S_ISDIR(st.st_mode):
         raise ScenarioError(source, "", "is a folder, not a scenario file")
     if not stat.S_ISREG(st.st_mode):
@@ -515,7 +520,7 @@ def _from_text(text: str, source: str) -> Scenario:
     try:
         data = load_yaml(text)
     except YamlLimitError as exc:
-        raise ScenarioError(source, "", str(exc)) from None
+        raise ScenarioError(source, exc.field, exc.text) from None
     if data is None:
         raise ScenarioError(source, "", "the file is empty")
     return scenario_from_dict(data, source)

@@ -37,10 +37,13 @@ MAX_SCALAR_CHARS = 10_000
 class YamlLimitError(ValueError):
     """The document is malformed or exceeds a limit; ``where`` is e.g. ``"line 3, column 5"``."""
 
-    def __init__(self, message: str, where: str = "") -> None:
+    def __init__(self, message: str, where: str = "", field: str = "") -> None:
         self.where = where
         self.message = message
-        super().__init__(f"{message} at {where}" if where else message)
+        self.field = field  # dotted path of the offending value, when known
+        text = f"{message} at {where}" if where else message
+        self.text = text
+        super().__init__(f"{field}: {text}" if field else text)
 
 
 def _where(node_or_mark: Any) -> str:
@@ -93,35 +96,41 @@ def _expanded_size(root: Node) -> int:
     depths: dict[int, int] = {}
     # Iterative post-order walk: aliases make the node graph a DAG (recursive ones are refused
     # by the composer), so memoised sizes are exact.
-    stack: list[tuple[Node, bool]] = [(root, False)]
+    stack: list[tuple[Node, bool, str]] = [(root, False, "")]
     while stack:
-        node, expanded = stack.pop()
+        node, expanded, path = stack.pop()
         nid = id(node)
         if nid in sizes:
             continue
         if isinstance(node, ScalarNode):
             if len(node.value) > MAX_SCALAR_CHARS:
                 raise YamlLimitError(f"a value longer than {MAX_SCALAR_CHARS} characters",
-                                     _where(node))
+                                     _where(node), path)
             sizes[nid] = 1
             depths[nid] = 0
             continue
         if isinstance(node, SequenceNode):
             children = list(node.value)
+            paths = [f"{path}[{i}]" for i in range(len(children))]
         else:
             children = [c for kv in node.value for c in kv]
+            paths = []
+            for k, _ in node.value:
+                key = k.value[:40] if isinstance(k, ScalarNode) else "?"
+                paths += [path, f"{path}.{key}" if path else key]
         if not expanded:
-            stack.append((node, True))
-            stack.extend((c, False) for c in children if id(c) not in sizes)
+            stack.append((node, True, path))
+            stack.extend((c, False, p) for c, p in zip(children, paths, strict=True)
+                         if id(c) not in sizes)
             continue
         total = 1 + sum(sizes[id(c)] for c in children)
         depth = 1 + max((depths[id(c)] for c in children), default=0)
         if depth > MAX_DEPTH:
-            raise YamlLimitError(f"nesting deeper than {MAX_DEPTH} levels", _where(node))
+            raise YamlLimitError(f"nesting deeper than {MAX_DEPTH} levels", _where(node), path)
         depths[nid] = depth
         if total > MAX_NODES:
             raise YamlLimitError(f"more than {MAX_NODES} values once its aliases are expanded "
-                                 "(an alias bomb?)", _where(node))
+                                 "(an alias bomb?)", _where(node), path)
         sizes[nid] = total
     return sizes[id(root)]
 

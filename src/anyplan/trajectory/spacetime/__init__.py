@@ -9,6 +9,7 @@
 """
 
 from anyplan.trajectory.spacetime.lattice import VelocityPlan, edge_ok, lattice_dt, plan_velocity
+from anyplan.trajectory.spacetime.stmap import STMap, build_stmap, radii_at
 from anyplan.trajectory.spacetime.timing import (
     RetimeResult,
     TimedCurveSegment,
@@ -16,7 +17,6 @@ from anyplan.trajectory.spacetime.timing import (
     speed_caps,
     verify,
 )
-from anyplan.trajectory.spacetime.stmap import STMap, build_stmap, radii_at
 
 __all__ = ["RetimeResult", "STMap", "TimedCurveSegment", "VelocityPlan", "build_stmap", "edge_ok",
            "lattice_dt", "plan_velocity", "radii_at", "retime", "speed_caps", "verify"]
