@@ -12,6 +12,16 @@ Data layout of an obstacle set:
     circles: (cx, cy, radius), shape (C, 3).
     bounds: arena (xmin, ymin, xmax, ymax); the robot must stay inside. ``bounds[0] > bounds[2]``
         disables the walls.
+    gmeta: uniform-grid index over the first polygons, (x0, y0, cell [m], nx, ny, n_indexed);
+        ``nx == 0`` means no index (every polygon is scanned, as for a few obstacles).
+        Polygons ``n_indexed:`` are always scanned linearly (e.g. a few added to a map).
+    gcsr: the grid's cells in CSR form, int64: ``gcsr[c]:gcsr[c + 1]`` (c = row * nx + col) are
+        positions in ``gcsr`` holding the indices of the polygons whose bounding box meets the
+        cell. See :mod:`anyplan.geometry.index`.
+
+A query against the grid is exact: it scans the cells within a distance R of the query
+(a conservative, padded cover of the capsule), and R grows until the best distance found is
+<= R, so no polygon nearer than the answer can be skipped.
 """
 
 from __future__ import annotations
@@ -83,8 +93,136 @@ def point_in_polygon(px: float, py: float, vx: np.ndarray, vy: np.ndarray, i0: i
 
 
 @njit(cache=True)
+def _poly_d2(ax: float, ay: float, bx: float, by: float, vx: np.ndarray, vy: np.ndarray,
+             i0: int, i1: int) -> float:
+    """Squared distance from segment ab (a point if a == b) to polygon ``i0:i1`` (0 on contact)."""
+    if point_in_polygon(ax, ay, vx, vy, i0, i1):
+        return 0.0
+    best = INF
+    j = i1 - 1
+    pt = ax == bx and ay == by
+    for i in range(i0, i1):
+        if pt:
+            d2 = pt_seg_d2(ax, ay, vx[j], vy[j], vx[i], vy[i])
+        else:
+            d2 = seg_seg_d2(ax, ay, bx, by, vx[j], vy[j], vx[i], vy[i])
+        if d2 < best:
+            best = d2
+            if best <= 0.0:
+                return 0.0
+        j = i
+    return best
+
+
+@njit(cache=True)
+def _grid_scan(ax: float, ay: float, bx: float, by: float, rad: float, best: float,
+               stop_below: float, exact: bool, vx: np.ndarray, vy: np.ndarray,
+               starts: np.ndarray, pbox: np.ndarray, gmeta: np.ndarray,
+               gcsr: np.ndarray) -> float:
+    """min(best, distance to the indexed polygons met by the cells within ``rad`` of ab).
+
+    Every polygon at distance <= ``rad`` from ab is tested (the cover is padded against
+    rounding); returns early once the distance is 0 or below ``stop_below``. With ``exact``
+    False only polygons nearer than ``stop_below`` matter (the others are skipped by the lower
+    bounds of their boxes)."""
+    x0 = gmeta[0]
+    y0 = gmeta[1]
+    h = gmeta[2]
+    nx = int(gmeta[3])
+    ny = int(gmeta[4])
+    pad = rad + 1e-9 * (1.0 + abs(ax) + abs(ay) + abs(bx) + abs(by) + abs(x0) + abs(y0))
+    j0 = int(math.floor((min(ay, by) - pad - y0) / h))
+    j1 = int(math.floor((max(ay, by) + pad - y0) / h))
+    if j1 < 0 or j0 >= ny:
+        return best
+    j0 = max(j0, 0)
+    j1 = min(j1, ny - 1)
+    dx = bx - ax
+    dy = by - ay
+    sx0 = min(ax, bx)
+    sx1 = max(ax, bx)
+    sy0 = min(ay, by)
+    sy1 = max(ay, by)
+    cut = best if exact else min(best, stop_below)
+    for j in range(j0, j1 + 1):
+        lo = y0 + j * h - pad
+        hi = y0 + (j + 1) * h + pad
+        if dy == 0.0:
+            if ay < lo or ay > hi:
+                continue
+            t0 = 0.0
+            t1 = 1.0
+        else:
+            ta = (lo - ay) / dy
+            tb = (hi - ay) / dy
+            t0 = max(min(ta, tb), 0.0)
+            t1 = min(max(ta, tb), 1.0)
+            if t0 > t1:
+                continue
+        xa = ax + t0 * dx
+        xb = ax + t1 * dx
+        i0 = int(math.floor((min(xa, xb) - pad - x0) / h))
+        i1 = int(math.floor((max(xa, xb) + pad - x0) / h))
+        if i1 < 0 or i0 >= nx:
+            continue
+        i0 = max(i0, 0)
+        i1 = min(i1, nx - 1)
+        for i in range(i0, i1 + 1):
+            c = j * nx + i
+            for q in range(gcsr[c], gcsr[c + 1]):
+                k = gcsr[q]
+                gx = max(pbox[k, 0] - sx1, 0.0, sx0 - pbox[k, 2])
+                gy = max(pbox[k, 1] - sy1, 0.0, sy0 - pbox[k, 3])
+                if gx * gx + gy * gy >= cut * cut:
+                    continue
+                # the polygon lies in the disc around its box: a second lower bound
+                hx = 0.5 * (pbox[k, 2] - pbox[k, 0])
+                hy = 0.5 * (pbox[k, 3] - pbox[k, 1])
+                dc = math.sqrt(pt_seg_d2(pbox[k, 0] + hx, pbox[k, 1] + hy, ax, ay, bx, by))
+                if dc - math.sqrt(hx * hx + hy * hy) >= cut:
+                    continue
+                d2 = _poly_d2(ax, ay, bx, by, vx, vy, starts[k], starts[k + 1])
+                if d2 < best * best:
+                    best = math.sqrt(d2)
+                    if best <= 0.0 or best < stop_below:
+                        return best
+                    if exact:
+                        cut = best
+    return best
+
+
+@njit(cache=True)
+def _grid_clearance(ax: float, ay: float, bx: float, by: float, best: float, stop_below: float,
+                    exact: bool, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray,
+                    pbox: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray) -> float:
+    """min(best, distance from ab to the indexed polygons), by scans of growing radius.
+
+    Exact unless the result is below ``stop_below`` (then some value below it) or, with
+    ``exact`` False, unless it is >= ``stop_below`` (then some value >= it: pass/fail only)."""
+    h = gmeta[2]
+    gx0 = gmeta[0]
+    gy0 = gmeta[1]
+    gx1 = gx0 + gmeta[3] * h
+    gy1 = gy0 + gmeta[4] * h
+    # a radius this large covers the whole grid (its farthest corner from a)
+    rmax = math.sqrt(max(abs(ax - gx0), abs(ax - gx1)) ** 2 + max(abs(ay - gy0), abs(ay - gy1)) ** 2)
+    rad = stop_below if stop_below > 0.0 else h
+    if rad > best:
+        rad = best
+    while True:
+        best = _grid_scan(ax, ay, bx, by, rad, best, stop_below, exact, vx, vy, starts, pbox,
+                          gmeta, gcsr)
+        if best <= 0.0 or best < stop_below or not exact:
+            return best
+        if best <= rad or rad >= rmax:
+            return best
+        rad = min(2.0 * rad, best)
+
+
+@njit(cache=True)
 def point_clearance(px: float, py: float, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray,
-                    pbox: np.ndarray, circles: np.ndarray, bounds: np.ndarray) -> float:
+                    pbox: np.ndarray, circles: np.ndarray, bounds: np.ndarray,
+                    gmeta: np.ndarray, gcsr: np.ndarray) -> float:
     """Distance [m] from point p to the nearest obstacle or wall; 0 inside an obstacle."""
     best = INF
     if bounds[0] <= bounds[2]:
@@ -98,7 +236,7 @@ def point_clearance(px: float, py: float, vx: np.ndarray, vy: np.ndarray, starts
             return 0.0
         if d < best:
             best = d
-    for k in range(starts.shape[0] - 1):
+    for k in range(int(gmeta[5]), starts.shape[0] - 1):
         # Lower bound from the bounding box first.
         gx = max(pbox[k, 0] - px, 0.0, px - pbox[k, 2])
         gy = max(pbox[k, 1] - py, 0.0, py - pbox[k, 3])
@@ -114,18 +252,16 @@ def point_clearance(px: float, py: float, vx: np.ndarray, vy: np.ndarray, starts
             if d2 < best * best:
                 best = math.sqrt(d2)
             j = i
+    if gmeta[3] > 0.0:
+        best = _grid_clearance(px, py, px, py, best, 0.0, True, vx, vy, starts, pbox, gmeta, gcsr)
     return best
 
 
 @njit(cache=True)
-def segment_clearance(ax: float, ay: float, bx: float, by: float, vx: np.ndarray, vy: np.ndarray,
-                      starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
-                      bounds: np.ndarray, stop_below: float) -> float:
-    """Minimum distance [m] from segment ab to any obstacle or wall (0 on contact).
-
-    Returns early, with some value below ``stop_below``, as soon as the clearance is known to
-    be smaller than ``stop_below`` (pass ``-1`` for the exact minimum).
-    """
+def _segment_clearance(ax: float, ay: float, bx: float, by: float, vx: np.ndarray,
+                       vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
+                       bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray,
+                       stop_below: float, exact: bool) -> float:
     best = INF
     if bounds[0] <= bounds[2]:
         # The distance to the boundary of a convex region is concave along a segment inside
@@ -150,7 +286,7 @@ def segment_clearance(ax: float, ay: float, bx: float, by: float, vx: np.ndarray
     sx1 = max(ax, bx)
     sy0 = min(ay, by)
     sy1 = max(ay, by)
-    for k in range(starts.shape[0] - 1):
+    for k in range(int(gmeta[5]), starts.shape[0] - 1):
         gx = max(pbox[k, 0] - sx1, 0.0, sx0 - pbox[k, 2])
         gy = max(pbox[k, 1] - sy1, 0.0, sy0 - pbox[k, 3])
         if gx * gx + gy * gy >= best * best:
@@ -169,27 +305,68 @@ def segment_clearance(ax: float, ay: float, bx: float, by: float, vx: np.ndarray
                 if best < stop_below:
                     return best
             j = i
+    if gmeta[3] > 0.0:
+        best = _grid_clearance(ax, ay, bx, by, best, stop_below, exact, vx, vy, starts, pbox,
+                               gmeta, gcsr)
     return best
+
+
+@njit(cache=True)
+def segment_clearance(ax: float, ay: float, bx: float, by: float, vx: np.ndarray, vy: np.ndarray,
+                      starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
+                      bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray,
+                      stop_below: float) -> float:
+    """Minimum distance [m] from segment ab to any obstacle or wall (0 on contact).
+
+    Returns early, with some value below ``stop_below``, as soon as the clearance is known to
+    be smaller than ``stop_below`` (pass ``-1`` for the exact minimum); otherwise exact.
+    """
+    return _segment_clearance(ax, ay, bx, by, vx, vy, starts, pbox, circles, bounds, gmeta, gcsr,
+                              stop_below, True)
+
+
+@njit(cache=True)
+def segment_blocked(ax: float, ay: float, bx: float, by: float, vx: np.ndarray, vy: np.ndarray,
+                    starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
+                    bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray,
+                    limit: float) -> bool:
+    """True iff the exact clearance of segment ab is < ``limit`` [m] (pass/fail only: on a map
+    it scans only the cells within ``limit`` of the segment)."""
+    return _segment_clearance(ax, ay, bx, by, vx, vy, starts, pbox, circles, bounds, gmeta, gcsr,
+                              limit, False) < limit
 
 
 @njit(cache=True)
 def points_clearance(px: np.ndarray, py: np.ndarray, vx: np.ndarray, vy: np.ndarray,
                      starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
-                     bounds: np.ndarray) -> np.ndarray:
+                     bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray) -> np.ndarray:
     """Vectorised :func:`point_clearance`, shape (N,)."""
     out = np.empty(px.shape[0])
     for n in range(px.shape[0]):
-        out[n] = point_clearance(px[n], py[n], vx, vy, starts, pbox, circles, bounds)
+        out[n] = point_clearance(px[n], py[n], vx, vy, starts, pbox, circles, bounds, gmeta, gcsr)
+    return out
+
+
+@njit(cache=True)
+def points_clear(px: np.ndarray, py: np.ndarray, vx: np.ndarray, vy: np.ndarray,
+                 starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray, bounds: np.ndarray,
+                 gmeta: np.ndarray, gcsr: np.ndarray, limit: float) -> np.ndarray:
+    """Mask (N,): the exact clearance of each point is >= ``limit`` [m] (pass/fail only)."""
+    out = np.empty(px.shape[0], dtype=np.bool_)
+    for n in range(px.shape[0]):
+        out[n] = _segment_clearance(px[n], py[n], px[n], py[n], vx, vy, starts, pbox, circles,
+                                    bounds, gmeta, gcsr, limit, False) >= limit
     return out
 
 
 @njit(cache=True)
 def segments_clearance(ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray,
                        vx: np.ndarray, vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
-                       circles: np.ndarray, bounds: np.ndarray, stop_below: float) -> np.ndarray:
+                       circles: np.ndarray, bounds: np.ndarray, gmeta: np.ndarray,
+                       gcsr: np.ndarray, stop_below: float) -> np.ndarray:
     """Vectorised :func:`segment_clearance`, shape (N,)."""
     out = np.empty(ax.shape[0])
     for n in range(ax.shape[0]):
         out[n] = segment_clearance(ax[n], ay[n], bx[n], by[n], vx, vy, starts, pbox, circles,
-                                   bounds, stop_below)
+                                   bounds, gmeta, gcsr, stop_below)
     return out

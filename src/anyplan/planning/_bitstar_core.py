@@ -303,7 +303,8 @@ def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np
             nstart: np.ndarray, nitems: np.ndarray, S: np.ndarray, N: np.ndarray,
             stack: np.ndarray, nb: np.ndarray, nd: np.ndarray,
             ovx: np.ndarray, ovy: np.ndarray, ostarts: np.ndarray, opbox: np.ndarray,
-            ocircles: np.ndarray, obounds: np.ndarray, max_iter: int) -> int:
+            ocircles: np.ndarray, obounds: np.ndarray, ogmeta: np.ndarray, ogcsr: np.ndarray,
+            max_iter: int) -> int:
     """Run one batch for up to ``max_iter`` units of work (edge pops plus vertex expansions).
 
     Returns RC_IMPROVED as soon as the goal's cost drops, RC_BATCH_DONE when the batch cannot
@@ -358,8 +359,8 @@ def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np
             continue
         # Exact, lazy edge check: is the straight motion free for the disc robot?
         N[N_CHECKS] += 1
-        if gk.segment_clearance(P[a, 0], P[a, 1], P[b, 0], P[b, 1], ovx, ovy, ostarts, opbox,
-                                ocircles, obounds, limit) < limit:
+        if gk.segment_blocked(P[a, 0], P[a, 1], P[b, 0], P[b, 1], ovx, ovy, ostarts, opbox,
+                              ocircles, obounds, ogmeta, ogcsr, limit):
             N[N_FAILS] += 1
             continue
         # The true cost equals the heuristic (straight line), so the tests above stand.
@@ -495,14 +496,15 @@ def compact(P: np.ndarray, F: np.ndarray, IT: np.ndarray, N: np.ndarray, state: 
 @njit(cache=True)
 def blocked_edges(P: np.ndarray, IT: np.ndarray, n: int, ovx: np.ndarray, ovy: np.ndarray,
                   ostarts: np.ndarray, opbox: np.ndarray, ocircles: np.ndarray,
-                  obounds: np.ndarray, limit: float) -> np.ndarray:
+                  obounds: np.ndarray, ogmeta: np.ndarray, ogcsr: np.ndarray,
+                  limit: float) -> np.ndarray:
     """Mask of vertices whose tree edge (parent -> vertex) is blocked by the given obstacles."""
     out = np.zeros(n, np.bool_)
     for i in range(n):
         p = IT[i, PAR]
         if p < 0:
             continue
-        if gk.segment_clearance(P[p, 0], P[p, 1], P[i, 0], P[i, 1], ovx, ovy, ostarts, opbox,
-                                ocircles, obounds, limit) < limit:
+        if gk.segment_blocked(P[p, 0], P[p, 1], P[i, 0], P[i, 1], ovx, ovy, ostarts, opbox,
+                              ocircles, obounds, ogmeta, ogcsr, limit):
             out[i] = True
     return out

@@ -309,7 +309,7 @@ class BITStar(Planner):
                     f = (np.hypot(*(pts - self.problem.start).T) + np.hypot(*(pts - self.problem.goal).T))
                     pts = pts[f < c_best]
             if len(pts):
-                pts = pts[self._obs.clearances(pts) >= self._limit]
+                pts = pts[self._obs.points_clear(pts, self._limit)]
             pts = pts[:need]
             out.append(pts)
             got += len(pts)

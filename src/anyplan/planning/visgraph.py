@@ -37,7 +37,9 @@ import numpy as np
 from numba import njit
 
 from anyplan.geometry import _kernels as gk
+from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.shapes import Circle, Polygon
+from anyplan.planning._visgraph_boxes import convex_box_corners, corner_arcs, inscribed_radius
 from anyplan.planning.base import Planner, PlanResult
 from anyplan.planning.problem import Problem
 from anyplan.planning.status import PlannerStatus
@@ -199,7 +201,26 @@ def _build(problem: Problem, variant: str, arc_step: float) -> _Builder:
             pts = _arc(v[i], r * grow, a0, a1, arc_step, circ)
             b.comps.append(np.vstack([v[i:i + 1], _arc(v[i], r, a0, a1, arc_step, False)]))
             b.chain(pts, pts[0] - d[i - 1], pts[-1] + d[i])
+    if len(problem.obstacles.boxes):
+        # A map's merged cells: nodes only around the convex corners of their union; their
+        # interior test is the exact clearance of the boxes (see _box_set).
+        corners, dirs = convex_box_corners(problem.obstacles.boxes, obstacles=_box_set(problem))
+        if r <= 0.0:  # a point robot: the boxes are interior-test components themselves
+            b.comps.extend(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+                           for x0, y0, x1, y1 in problem.obstacles.boxes)
+        for pts, before, after in corner_arcs(corners, dirs, r, arc_step, circ, grow, _arc):
+            b.chain(pts, before, after)
     return b
+
+
+def _box_set(problem: Problem) -> ObstacleSet:
+    """The boxes alone, without walls and shapes (cached on the obstacle set)."""
+    obs = problem.obstacles
+    cached = getattr(obs, "_visgraph_boxes", None)
+    if cached is None:
+        cached = ObstacleSet([], boxes=obs.boxes)
+        obs._visgraph_boxes = cached  # type: ignore[attr-defined]
+    return cached
 
 
 def _radius(problem: Problem, variant: str) -> float:
@@ -298,8 +319,13 @@ def _edges(px: np.ndarray, py: np.ndarray, prv: np.ndarray, nxt: np.ndarray, n_f
            exact: bool, radius: float, starts: np.ndarray, box: np.ndarray, nx: np.ndarray,
            ny: np.ndarray, off: np.ndarray, ovx: np.ndarray, ovy: np.ndarray,
            ostarts: np.ndarray, opbox: np.ndarray, ocircles: np.ndarray,
-           obounds: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Visible bitangent edges; nodes ``[0, n_free)`` (start, goal) skip the tangent test."""
+           obounds: np.ndarray, ogmeta: np.ndarray, ogcsr: np.ndarray,
+           box_limit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Visible bitangent edges; nodes ``[0, n_free)`` (start, goal) skip the tangent test.
+
+    ``exact``: the exact test at ``radius`` against the obstacle arrays ``o*``; else the
+    interior test of the components and, if ``box_limit`` > 0, the exact test at
+    ``box_limit`` against the arrays ``o*`` (then a map's boxes alone)."""
     n = px.shape[0]
     cap = 1024
     ei = np.empty(cap, np.int64)
@@ -315,13 +341,16 @@ def _edges(px: np.ndarray, py: np.ndarray, prv: np.ndarray, nxt: np.ndarray, n_f
                                             nxt[j, 1], px[i], py[i]):
                 continue
             if exact:
-                c = gk.segment_clearance(px[i], py[i], px[j], py[j], ovx, ovy, ostarts, opbox,
-                                         ocircles, obounds, limit)
-                if c < limit:
+                if gk.segment_blocked(px[i], py[i], px[j], py[j], ovx, ovy, ostarts, opbox,
+                                      ocircles, obounds, ogmeta, ogcsr, limit):
                     continue
             else:
                 if _segment_hits_any(px[i], py[i], px[j], py[j], starts, box, nx, ny, off,
                                      1e-9):
+                    continue
+                if box_limit > 0.0 and gk.segment_blocked(px[i], py[i], px[j], py[j], ovx, ovy,
+                                                          ostarts, opbox, ocircles, obounds,
+                                                          ogmeta, ogcsr, box_limit):
                     continue
             if m == cap:
                 cap *= 2
@@ -379,6 +408,10 @@ def shortest_path(problem: Problem, *, variant: str = "feasible",
     b = _build(problem, variant, arc_step)
     xs, ys, starts, box, nx, ny, off = _pack(b.comps)
     r = _radius(problem, variant)
+    # Lower variant on a map: the inscribed chains of the boxes' inflated corners contain the
+    # boxes inflated by the chords' distance, so clearance >= that distance is a relaxation.
+    box_limit = (inscribed_radius(r, arc_step) - 1e-9
+                 if variant == "lower" and len(problem.obstacles.boxes) and r > 0.0 else 0.0)
     xmin, ymin, xmax, ymax = problem.bounds
     if b.nodes:
         nodes = np.array(b.nodes)
@@ -392,6 +425,8 @@ def shortest_path(problem: Problem, *, variant: str = "feasible",
         if variant == "feasible":
             keep &= problem.obstacles.points_free(nodes, problem.check_radius)
         else:
+            if box_limit > 0.0:
+                keep &= _box_set(problem).clearances(nodes) >= box_limit
             for i in np.flatnonzero(keep):
                 if _point_in_any(nodes[i, 0], nodes[i, 1], starts, box, nx, ny, off, _EPS):
                     keep[i] = False
@@ -404,10 +439,10 @@ def shortest_path(problem: Problem, *, variant: str = "feasible",
     if not prune_tangent:
         prv = nxt = np.ascontiguousarray(np.repeat(pts[:, None, :], 1, axis=1)[:, 0, :])
     exact = variant == "feasible"
-    ovx, ovy, ost, opb, oci, obd = problem.obstacles.kernel_args
+    oargs = problem.obstacles.kernel_args if exact or box_limit <= 0.0 else \
+        _box_set(problem).kernel_args
     ei, ej, w = _edges(np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), prv, nxt,
-                       2, exact, problem.check_radius, starts, box, nx, ny, off,
-                       ovx, ovy, ost, opb, oci, obd)
+                       2, exact, problem.check_radius, starts, box, nx, ny, off, *oargs, box_limit)
     from scipy.sparse import coo_matrix  # lazy: keeps `import anyplan.planning` light
     from scipy.sparse.csgraph import dijkstra
 

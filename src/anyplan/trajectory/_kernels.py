@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
-from anyplan.geometry._kernels import segment_clearance
+from anyplan.geometry._kernels import segment_blocked, segment_clearance
 
 # Gauss-Legendre nodes/weights on [0, 1] (5 points: exact for polynomials of degree 9).
 _X, _W = np.polynomial.legendre.leggauss(5)
@@ -493,7 +493,8 @@ def curve_sample(x: np.ndarray, c: np.ndarray, s_grid: np.ndarray, u_grid: np.nd
 @njit(cache=True)
 def certify(x: np.ndarray, c: np.ndarray, u: np.ndarray, limit: float, radius: float,
             max_depth: int, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
-            circles: np.ndarray, bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+            circles: np.ndarray, bounds: np.ndarray, gmeta: np.ndarray,
+            gcsr: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """Certified chord test of the pieces [u_j, u_{j+1}] with up to ``max_depth`` 4-way splits.
 
     A piece is certified when (exact chord clearance) - M h^2 / 8 >= ``limit``
@@ -523,7 +524,7 @@ def certify(x: np.ndarray, c: np.ndarray, u: np.ndarray, limit: float, radius: f
         for j in range(n):
             stop = -1.0 if last else limit + dev[j] - 1e-9
             cl = segment_clearance(pa[j, 0], pa[j, 1], pb[j, 0], pb[j, 1], vx, vy, starts, pbox,
-                                   circles, bounds, stop)
+                                   circles, bounds, gmeta, gcsr, stop)
             if cl < stop:
                 fail[j] = True
                 nf += 1
@@ -689,7 +690,7 @@ def clean_points(p: np.ndarray, tol: float, collinear_tol: float) -> np.ndarray:
 @njit(cache=True)
 def shortcut_indices(p: np.ndarray, limit: float, vx: np.ndarray, vy: np.ndarray,
                      starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
-                     bounds: np.ndarray) -> np.ndarray:
+                     bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray) -> np.ndarray:
     """Indices kept by ``spline.shortcut_path``: from each kept vertex, the farthest one whose
     straight segment has clearance >= ``limit`` (else the next vertex). Scanning from the far end
     with the query stopping early below ``limit`` gives exactly the pass/fail of the exact
@@ -702,9 +703,8 @@ def shortcut_indices(p: np.ndarray, limit: float, vx: np.ndarray, vy: np.ndarray
     while i < n - 1:
         nxt = i + 1
         for j in range(n - 1, i + 1, -1):
-            cl = segment_clearance(p[i, 0], p[i, 1], p[j, 0], p[j, 1], vx, vy, starts, pbox,
-                                   circles, bounds, limit)
-            if cl >= limit:
+            if not segment_blocked(p[i, 0], p[i, 1], p[j, 0], p[j, 1], vx, vy, starts, pbox,
+                                   circles, bounds, gmeta, gcsr, limit):
                 nxt = j
                 break
         keep[nk] = nxt
@@ -825,7 +825,8 @@ def _argsort_stable(v: np.ndarray) -> np.ndarray:
 def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarray, limit: float,
                   radius: float, max_depth: int, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray,
                   pbox: np.ndarray, circles: np.ndarray,
-                  bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+                  bounds: np.ndarray, gmeta: np.ndarray,
+                  gcsr: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """:func:`certify` reduced to what the repair uses, by branch and bound.
 
     Returns, for each interpolation interval k (``point_u[k:k+2]``) that has a piece failing at
@@ -871,7 +872,8 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
     hint = 0
     for j in range(m):
         pax, pay, pbx, pby, dev, hint = _chord_dev_one(x, c, u[j], u[j + 1], hint)
-        cl = segment_clearance(pax, pay, pbx, pby, vx, vy, starts, pbox, circles, bounds, -1.0)
+        cl = segment_clearance(pax, pay, pbx, pby, vx, vy, starts, pbox, circles, bounds, gmeta,
+                               gcsr, -1.0)
         cj = cl - dev
         if cj >= limit:
             margin = min(margin, cj - radius)
@@ -930,6 +932,7 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
                 b2 = a + w * ((p + 1) / 4.0)
                 pax, pay, pbx, pby, dev, h2 = _chord_dev_one(x, c, a2, b2, h2)
                 cl = segment_clearance(pax, pay, pbx, pby, vx, vy, starts, pbox, circles, bounds,
+                                       gmeta, gcsr,
                                        -1.0)
                 c2 = cl - dev
                 if c2 >= limit:

@@ -17,7 +17,13 @@ __all__ = ["draw_scenario", "draw_run"]
 
 def draw_scenario(ax: Any, scenario: Scenario, **_: Any) -> None:
     """Arena, static obstacles, start and goal."""
-    ax.add_patch(Rectangle((0.0, 0.0), scenario.width, scenario.height, fill=False, lw=2.0, ec="black"))
+    x0, y0, x1, y1 = scenario.bounds
+    if scenario.static_map is not None:
+        m = scenario.static_map
+        mx0, my0, mx1, my1 = m.bounds
+        ax.imshow(m.blocked, cmap="Greys", vmin=0, vmax=2, origin="lower", interpolation="nearest",
+                  extent=(mx0, mx1, my0, my1), zorder=1)
+    ax.add_patch(Rectangle((x0, y0), scenario.width, scenario.height, fill=False, lw=2.0, ec="black"))
     for o in scenario.static_obstacles:
         s = o.shape
         if isinstance(s, Circle):
@@ -27,8 +33,8 @@ def draw_scenario(ax: Any, scenario: Scenario, **_: Any) -> None:
     r = scenario.robot
     ax.plot([r.start[0]], [r.start[1]], "o", color="#2ca02c")
     ax.plot([r.goal[0]], [r.goal[1]], "*", ms=12, color="#2ca02c", mec="black")
-    ax.set_xlim(-0.3, scenario.width + 0.3)
-    ax.set_ylim(-0.3, scenario.height + 0.3)
+    ax.set_xlim(x0 - 0.3, x1 + 0.3)
+    ax.set_ylim(y0 - 0.3, y1 + 0.3)
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")

@@ -57,8 +57,9 @@ def draw_run_panel(ax: Any, scenario: Scenario, result: dict[str, Any]) -> None:
 
     draw_run(ax, scenario, result, colorbar=False, title=False)
     # Obstacles may leave the arena: keep the panel on the arena and clip labels outside it.
-    ax.set_xlim(-0.3, scenario.width + 0.3)
-    ax.set_ylim(-0.3, scenario.height + 0.3)
+    x0, y0, x1, y1 = scenario.bounds
+    ax.set_xlim(x0 - 0.3, x1 + 0.3)
+    ax.set_ylim(y0 - 0.3, y1 + 0.3)
     for artist in [*ax.texts, *ax.patches, *ax.lines, *ax.collections]:
         artist.set_clip_on(True)
 

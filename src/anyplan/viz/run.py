@@ -36,7 +36,13 @@ MOVER_COLORS = ["#d62728", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"
 
 def draw_scenario(ax: Any, scenario: Scenario, *, labels: bool = True) -> None:
     """Draw the arena, the static obstacles (labelled), the start and the goal on ``ax``."""
-    ax.add_patch(Rectangle((0.0, 0.0), scenario.width, scenario.height, fill=False, lw=2.0,
+    x0, y0, x1, y1 = scenario.bounds
+    if scenario.static_map is not None:
+        m = scenario.static_map
+        mx0, my0, mx1, my1 = m.bounds
+        ax.imshow(m.blocked, cmap="Greys", vmin=0, vmax=2, origin="lower", interpolation="nearest",
+                  extent=(mx0, mx1, my0, my1), zorder=1)
+    ax.add_patch(Rectangle((x0, y0), scenario.width, scenario.height, fill=False, lw=2.0,
                            ec="black", zorder=1))
     for o in scenario.static_obstacles:
         s = o.shape
@@ -63,8 +69,8 @@ def draw_scenario(ax: Any, scenario: Scenario, *, labels: bool = True) -> None:
                              zorder=5))
     ax.plot([gx], [gy], marker="*", ms=14, color="#2ca02c", mec="black", mew=0.6, zorder=7)
     ax.text(gx, gy - 0.35, "goal", ha="center", va="top", fontsize=8, color="#2ca02c")
-    ax.set_xlim(-0.3, scenario.width + 0.3)
-    ax.set_ylim(-0.3, scenario.height + 0.3)
+    ax.set_xlim(x0 - 0.3, x1 + 0.3)
+    ax.set_ylim(y0 - 0.3, y1 + 0.3)
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")

@@ -26,6 +26,7 @@ from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.geometry.shapes import Circle, Polygon, Shape, rectangle
 from anyplan.world import limits as L
 from anyplan.world.motion import Motion, TrackMotion, UnicycleMotion, WaypointMotion
+from anyplan.world.occupancy import OccupancyMap, load_map
 from anyplan.world.robot import RobotSpec
 from anyplan.world.sensing import SensingSpec
 from anyplan.world.yaml_load import YamlLimitError, load_yaml
@@ -78,15 +79,26 @@ class Scenario:
     source: str = "<dict>"
     #: Perception settings (``sensing:``); None = no block = ``oracle``.
     sensing: SensingSpec | None = None
+    #: Lower-left corner (x, y) [m] of the arena.
+    origin: tuple[float, float] = (0.0, 0.0)
+    #: An occupancy-grid map whose blocked cells are static obstacles too (``static_map:``).
+    static_map: OccupancyMap | None = None
+    _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
         """Arena (xmin, ymin, xmax, ymax) [m]."""
-        return (0.0, 0.0, self.width, self.height)
+        x0, y0 = self.origin
+        return (x0, y0, x0 + self.width, y0 + self.height)
 
     def obstacle_set(self) -> ObstacleSet:
-        """The static obstacles and the arena walls, for exact clearance queries."""
-        return ObstacleSet([o.shape for o in self.static_obstacles], bounds=self.bounds)
+        """The static obstacles, the map's blocked cells (merged into boxes) and the arena
+        walls, for exact clearance queries. Built once per scenario (it is immutable)."""
+        if "obs" not in self._cache:
+            boxes = None if self.static_map is None else self.static_map.boxes
+            self._cache["obs"] = ObstacleSet([o.shape for o in self.static_obstacles],
+                                             bounds=self.bounds, boxes=boxes)
+        return self._cache["obs"]
 
     def nearest_static(self, a: Sequence[float] | np.ndarray,
                        b: Sequence[float] | np.ndarray | None = None) -> str:
@@ -96,6 +108,12 @@ class Scenario:
             return obs.clearance(a) if b is None else obs.segment_clearance(a, b)
 
         best, name = dist(ObstacleSet([], bounds=self.bounds)), "wall"
+        if self.static_map is not None:
+            if "map_obs" not in self._cache:
+                self._cache["map_obs"] = ObstacleSet([], boxes=self.static_map.boxes)
+            d = dist(self._cache["map_obs"])
+            if d < best:
+                best, name = d, "map"
         for o in self.static_obstacles:
             d = dist(ObstacleSet([o.shape]))
             if d < best:
@@ -121,6 +139,10 @@ class Scenario:
             out["description"] = self.description
         out["time_limit"] = self.time_limit
         out["arena"] = {"width": self.width, "height": self.height}
+        if self.origin != (0.0, 0.0):
+            out["arena"]["origin"] = list(self.origin)
+        if self.static_map is not None:
+            out["static_map"] = str(Path(self.static_map.source).resolve())
         out["robot"] = robot
         out["static_obstacles"] = [dict(o.spec) for o in self.static_obstacles]
         out["dynamic_obstacles"] = [dict(o.spec) for o in self.moving_obstacles]
@@ -130,7 +152,10 @@ class Scenario:
 
     def content_hash(self) -> str:
         """SHA-256 (hex, 16 chars) of the scenario's canonical JSON, ignoring its source."""
-        blob = json.dumps(self.to_dict(), sort_keys=True, default=float).encode()
+        d = self.to_dict()
+        if self.static_map is not None:
+            d["static_map"] = self.static_map.digest()  # the content, not where it lives
+        blob = json.dumps(d, sort_keys=True, default=float).encode()
         return hashlib.sha256(blob).hexdigest()[:16]
 
 
@@ -376,8 +401,9 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     """
     c = _Ctx(source)
     top = c.mapping(data, "")
-    c.keys(top, "", ("name", "arena", "robot"),
-           ("description", "time_limit", "static_obstacles", "dynamic_obstacles", "sensing"))
+    c.keys(top, "", ("name", "robot"),
+           ("arena", "description", "time_limit", "static_obstacles", "dynamic_obstacles",
+            "sensing", "static_map"))
     name = c.string(top["name"], "name")
     description = top.get("description")
     if description is None:
@@ -389,10 +415,22 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     time_limit = c.number(top.get("time_limit", 120.0), "time_limit", positive=True,
                           hi=L.MAX_TIME_LIMIT_S)
 
-    arena = c.mapping(top["arena"], "arena")
-    c.keys(arena, "arena", ("width", "height"))
-    width = c.number(arena["width"], "arena.width", positive=True, hi=L.MAX_ARENA_M)
-    height = c.number(arena["height"], "arena.height", positive=True, hi=L.MAX_ARENA_M)
+    smap = _static_map(c, top.get("static_map"))
+    if "arena" not in top and smap is None:
+        raise c.fail("arena", "missing required key (it may be omitted only with static_map)")
+    if "arena" in top:
+        arena = c.mapping(top["arena"], "arena")
+        c.keys(arena, "arena", ("width", "height"), ("origin",))
+        width = c.number(arena["width"], "arena.width", positive=True, hi=L.MAX_ARENA_M)
+        height = c.number(arena["height"], "arena.height", positive=True, hi=L.MAX_ARENA_M)
+        ox, oy = c.vector(arena.get("origin", [0.0, 0.0]), "arena.origin", 2)
+    else:
+        assert smap is not None
+        ox, oy, x1, y1 = smap.bounds
+        width, height = x1 - ox, y1 - oy
+        if max(width, height) > L.MAX_ARENA_M:
+            raise c.fail("static_map", f"the map is {width:g} m x {height:g} m, larger than the "
+                                       f"arena limit {L.MAX_ARENA_M:g} m (give a smaller arena)")
 
     rob = c.mapping(top["robot"], "robot")
     c.keys(rob, "robot", _ROBOT_REQUIRED, _ROBOT_OPTIONAL)
@@ -424,7 +462,7 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
 
     sc = Scenario(name=name, width=width, height=height, robot=robot, static_obstacles=statics,
                   moving_obstacles=moving, description=description, time_limit=time_limit,
-                  source=source,
+                  source=source, origin=(ox, oy), static_map=smap,
                   sensing=None if top.get("sensing") is None else _parse_sensing(c, top["sensing"]))
     _check_task(c, sc)
     return sc
@@ -433,15 +471,31 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
 def _check_task(c: _Ctx, sc: Scenario) -> None:
     r = sc.robot.radius
     obs = sc.obstacle_set()
+    x0, y0, x1, y1 = sc.bounds
     for fld, p in (("robot.start", sc.robot.start[:2]), ("robot.goal", sc.robot.goal)):
         x, y = p
-        if not (r <= x <= sc.width - r and r <= y <= sc.height - r):
-            raise c.fail(fld, f"({x:g}, {y:g}) is outside the arena [0, {sc.width:g}] x "
-                              f"[0, {sc.height:g}] shrunk by the robot radius {r:g}")
+        if not (x0 + r <= x <= x1 - r and y0 + r <= y <= y1 - r):
+            raise c.fail(fld, f"({x:g}, {y:g}) is outside the arena [{x0:g}, {x1:g}] x "
+                              f"[{y0:g}, {y1:g}] shrunk by the robot radius {r:g}")
         if obs.clearance(p) < r - COLLISION_EPS:
             hit = sc.nearest_static(p)
+            if hit == "map" and sc.static_map is not None:
+                raise c.fail(fld, f"({x:g}, {y:g}) is within the robot radius {r:g} of an "
+                                  f"occupied or unknown cell of the map {sc.static_map.source}")
             raise c.fail(fld, f"({x:g}, {y:g}) is inside static obstacle {hit} inflated by the "
                               f"robot radius {r:g}")
+
+
+def _static_map(c: _Ctx, obj: Any) -> OccupancyMap | None:
+    """The ``static_map`` key: a map_server YAML path, relative to the scenario file."""
+    if obj is None:
+        return None
+    rel = Path(c.string(obj, "static_map"))
+    base = Path(c.source).parent if c.source not in ("<dict>", "") else Path.cwd()
+    path = rel if rel.is_absolute() else base / rel
+    if not path.is_file():
+        raise c.fail("static_map", f"no such map file {path}")
+    return load_map(path)
 
 
 # --------------------------------------------------------------------------------------------

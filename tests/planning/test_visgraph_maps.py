@@ -1,0 +1,63 @@
+"""The visibility graph and BIT* on maps (merged cells as boxes): same optimum as the boxes given
+as polygons (the general, per-shape construction), valid paths, and the lower bound below it."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from anyplan.geometry import ObstacleSet, Polygon
+from anyplan.geometry.cells import cell_boxes, merge_cells
+from anyplan.planning import plan
+from anyplan.planning.problem import Problem
+from anyplan.planning.status import PlannerStatus
+from anyplan.planning.visgraph import shortest_path
+
+
+def _random_map(seed: int, ny: int = 16, nx: int = 20, p: float = 0.12, res: float = 0.25):
+    rng = np.random.default_rng(seed)
+    occ = rng.random((ny, nx)) < p
+    occ[:2, :2] = False       # start corner
+    occ[-2:, -2:] = False     # goal corner
+    return occ, cell_boxes(merge_cells(occ), (0.0, 0.0), res)
+
+
+def _as_polygons(boxes: np.ndarray) -> list[Polygon]:
+    return [Polygon(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])) for x0, y0, x1, y1 in boxes]
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("radius", [0.0, 0.1])
+def test_map_visgraph_equals_polygon_visgraph(seed, radius):
+    occ, boxes = _random_map(seed)
+    bounds = (0.0, 0.0, 5.0, 4.0)
+    start, goal = (0.25, 0.25), (4.75, 3.75)
+    as_map = Problem.create(ObstacleSet([], bounds=bounds, boxes=boxes), start, goal, radius)
+    as_polys = Problem.create(ObstacleSet(_as_polygons(boxes), bounds=bounds, index=False),
+                              start, goal, radius)
+    for variant in ("lower", "feasible"):
+        a = shortest_path(as_map, variant=variant, arc_step=math.pi / 16)
+        b = shortest_path(as_polys, variant=variant, arc_step=math.pi / 16)
+        assert a.status == b.status
+        if a.status is PlannerStatus.EXACT_SOLUTION:
+            assert a.cost == pytest.approx(b.cost, rel=1e-9, abs=1e-9)
+            if variant == "feasible":
+                assert as_map.obstacles.path_free(a.path, as_map.check_radius)
+            # corner pruning: far fewer nodes than one per box corner
+            assert a.n_nodes <= b.n_nodes
+
+
+def test_lower_bound_is_below_the_feasible_path_on_a_map():
+    occ, boxes = _random_map(12, 30, 40, 0.08, 0.2)
+    obs = ObstacleSet([], bounds=(0.0, 0.0, 8.0, 6.0), boxes=boxes)
+    prob = Problem.create(obs, (0.2, 0.2), (7.8, 5.8), 0.15)
+    lo = shortest_path(prob, variant="lower", arc_step=math.pi / 8)
+    hi = shortest_path(prob, variant="feasible", arc_step=math.pi / 8)
+    assert lo.status is hi.status is PlannerStatus.EXACT_SOLUTION
+    assert lo.cost <= hi.cost <= lo.cost * 1.01
+    assert obs.path_free(hi.path, prob.check_radius)
+    best = plan(obs, (0.2, 0.2), (7.8, 5.8), 0.15, time_budget_s=0.3, rng=0)
+    assert best.status and best.cost >= lo.cost - 1e-9
+    assert obs.path_free(best.path, 0.15)
