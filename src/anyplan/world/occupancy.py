@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import hashlib
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -40,6 +40,8 @@ import yaml
 
 from anyplan.errors import ScenarioError
 from anyplan.geometry.cells import cell_boxes, merge_cells
+from anyplan.geometry.collision import ObstacleSet
+from anyplan.geometry.shapes import Shape
 
 __all__ = ["OccupancyMap", "load_map", "read_pgm", "read_image", "MAX_CELLS"]
 
@@ -109,6 +111,16 @@ class OccupancyMap:
             b.setflags(write=False)
             self._cache["boxes"] = b
         return self._cache["boxes"]
+
+    def obstacle_set(self, shapes: Sequence[Shape] = (),
+                     bounds: Sequence[float] | None = None) -> ObstacleSet:
+        """The merged boxes with ``shapes`` and the walls ``bounds``, as an (indexed)
+        :class:`~anyplan.geometry.collision.ObstacleSet`; cached per (shapes, bounds)."""
+        key = (tuple(shapes), None if bounds is None else tuple(float(b) for b in bounds))
+        cache = self._cache.setdefault("obstacle_sets", {})
+        if key not in cache:
+            cache[key] = ObstacleSet(key[0], bounds=key[1], boxes=self.boxes)
+        return cache[key]
 
     def cell_of(self, x: float, y: float) -> tuple[int, int] | None:
         """(row, col) of the cell containing (x, y) [m], None outside the map."""

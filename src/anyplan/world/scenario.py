@@ -83,7 +83,6 @@ class Scenario:
     origin: tuple[float, float] = (0.0, 0.0)
     #: An occupancy-grid map whose blocked cells are static obstacles too (``static_map:``).
     static_map: OccupancyMap | None = None
-    _cache: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
@@ -93,12 +92,11 @@ class Scenario:
 
     def obstacle_set(self) -> ObstacleSet:
         """The static obstacles, the map's blocked cells (merged into boxes) and the arena
-        walls, for exact clearance queries. Built once per scenario (it is immutable)."""
-        if "obs" not in self._cache:
-            boxes = None if self.static_map is None else self.static_map.boxes
-            self._cache["obs"] = ObstacleSet([o.shape for o in self.static_obstacles],
-                                             bounds=self.bounds, boxes=boxes)
-        return self._cache["obs"]
+        walls, for exact clearance queries (with a map, built once and cached by the map)."""
+        shapes = [o.shape for o in self.static_obstacles]
+        if self.static_map is None:
+            return ObstacleSet(shapes, bounds=self.bounds)
+        return self.static_map.obstacle_set(shapes, self.bounds)
 
     def nearest_static(self, a: Sequence[float] | np.ndarray,
                        b: Sequence[float] | np.ndarray | None = None) -> str:
@@ -109,9 +107,7 @@ class Scenario:
 
         best, name = dist(ObstacleSet([], bounds=self.bounds)), "wall"
         if self.static_map is not None:
-            if "map_obs" not in self._cache:
-                self._cache["map_obs"] = ObstacleSet([], boxes=self.static_map.boxes)
-            d = dist(self._cache["map_obs"])
+            d = dist(self.static_map.obstacle_set((), None))
             if d < best:
                 best, name = d, "map"
         for o in self.static_obstacles:
