@@ -211,6 +211,7 @@ FREE = np.full((1, 3), 255)
     (GOOD + "mode: trinery\n", FREE, "m.yaml: mode", "did you mean 'trinary'"),
     (GOOD + "colour: 1\n", FREE, "m.yaml: colour", "unknown key"),
     (GOOD.replace("negate: 0\n", ""), FREE, "m.yaml: negate", "missing required key"),
+    (GOOD + "negate: 1\n", FREE, "m.yaml", "duplicate key"),
     (GOOD, np.array([[255, 255, 255], [0, 255, 255]]), "s.yaml: robot.start",
      "occupied or unknown cell"),
     (GOOD, np.array([[255, 255, 205]]), "s.yaml: robot.goal", "occupied or unknown cell"),

@@ -36,12 +36,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from anyplan.errors import ScenarioError
 from anyplan.geometry.cells import cell_boxes, merge_cells
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.shapes import Shape
+from anyplan.world.yaml_load import YamlLimitError, load_yaml
 
 __all__ = ["OccupancyMap", "load_map", "read_pgm", "read_image", "MAX_CELLS"]
 
@@ -293,13 +293,11 @@ def load_map(path: str | Path) -> OccupancyMap:
     if not p.is_file():
         raise ScenarioError(src, "", "no such map file")
     try:
-        data = yaml.safe_load(p.read_text())
+        data = load_yaml(p.read_text())
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(src, "", f"cannot read file ({exc.__class__.__name__})") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}" if mark else ""
-        raise ScenarioError(src, "", f"malformed YAML{where}") from None
+    except YamlLimitError as exc:  # malformed, duplicate keys, limits (strict, as scenarios)
+        raise ScenarioError(src, "", str(exc)) from None
     if not isinstance(data, Mapping):
         raise ScenarioError(src, "", "expected a mapping of map_server keys (image, resolution, "
                                      "origin, negate, occupied_thresh, free_thresh)")
