@@ -61,3 +61,25 @@ def test_lower_bound_is_below_the_feasible_path_on_a_map():
     best = plan(obs, (0.2, 0.2), (7.8, 5.8), 0.15, time_budget_s=0.3, rng=0)
     assert best.status and best.cost >= lo.cost - 1e-9
     assert obs.path_free(best.path, 0.15)
+
+
+def test_cell_cover_proves_disconnection_and_never_a_false_one():
+    from anyplan.planning.connectivity import provably_disconnected
+
+    occ = np.zeros((20, 30), dtype=bool)
+    occ[:, 14:16] = True                       # a wall cutting the map in two
+    boxes = cell_boxes(merge_cells(occ), (0.0, 0.0), 0.2)
+    obs = ObstacleSet([], bounds=(0.0, 0.0, 6.0, 4.0), boxes=boxes)
+    assert provably_disconnected(obs, (1.0, 2.0), (5.0, 2.0), 0.2)
+    occ[9:12, 14:16] = False                   # a 0.6 m door: reachable for a 0.2 m disc
+    boxes = cell_boxes(merge_cells(occ), (0.0, 0.0), 0.2)
+    obs = ObstacleSet([], bounds=(0.0, 0.0, 6.0, 4.0), boxes=boxes)
+    assert not provably_disconnected(obs, (1.0, 2.0), (5.0, 2.0), 0.2)
+    prob = Problem.create(obs, (1.0, 2.0), (5.0, 2.0), 0.2)
+    assert shortest_path(prob, variant="feasible").status is PlannerStatus.EXACT_SOLUTION
+    for seed in range(8):   # never claims disconnection where the visibility graph finds a path
+        _, boxes = _random_map(seed, 16, 20, 0.15, 0.25)
+        obs = ObstacleSet([], bounds=(0.0, 0.0, 5.0, 4.0), boxes=boxes)
+        prob = Problem.create(obs, (0.25, 0.25), (4.75, 3.75), 0.1)
+        if shortest_path(prob, variant="feasible").status is PlannerStatus.EXACT_SOLUTION:
+            assert not provably_disconnected(obs, (0.25, 0.25), (4.75, 3.75), 0.1)

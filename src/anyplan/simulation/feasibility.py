@@ -5,13 +5,16 @@ relaxation: its obstacles (inflated by the robot radius, rounded corners replace
 chords) lie inside the true ones, so when it finds no path, no collision-free path to the goal
 point exists. A run ends at the goal when the robot is within ``goal_tolerance`` of it, so the
 proof also needs that whole disc to be free: it is then connected to the goal point and cut off
-from the start like it. Otherwise the check is inconclusive and the run goes ahead.
+from the start like it. Otherwise the check is inconclusive and the run goes ahead. On a map
+(``static_map``), :func:`anyplan.planning.connectivity.provably_disconnected` (a cell cover,
+linear in the arena's area) gives the proof instead.
 """
 
 from __future__ import annotations
 
 import math
 
+from anyplan.planning.connectivity import provably_disconnected
 from anyplan.planning.problem import Problem
 from anyplan.planning.visgraph import lower_bound
 from anyplan.world.scenario import Scenario
@@ -31,4 +34,7 @@ def goal_unreachable(scenario: Scenario) -> bool:
     problem = Problem.create(obstacles, start, goal, r.radius)
     if not (problem.start_valid() and problem.goal_valid()):
         return False  # the loader refuses these; nothing is proven here
+    if scenario.static_map is not None:
+        # a map's many corners make the visibility graph slow: a cell-cover proof instead
+        return provably_disconnected(obstacles, start, goal, r.radius)
     return math.isinf(lower_bound(problem))
