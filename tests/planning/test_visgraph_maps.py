@@ -83,3 +83,17 @@ def test_cell_cover_proves_disconnection_and_never_a_false_one():
         prob = Problem.create(obs, (0.25, 0.25), (4.75, 3.75), 0.1)
         if shortest_path(prob, variant="feasible").status is PlannerStatus.EXACT_SOLUTION:
             assert not provably_disconnected(obs, (0.25, 0.25), (4.75, 3.75), 0.1)
+
+
+def test_many_obstacle_scenarios_are_seeded_and_valid():
+    from anyplan.experiments.many import many_obstacles
+
+    a, b = many_obstacles(25, rng=3), many_obstacles(25, rng=3)
+    assert len(a.moving_obstacles) == 25 and a.content_hash() == b.content_hash()
+    assert many_obstacles(25, rng=4).content_hash() != a.content_hash()
+    x0, y0, x1, y1 = a.bounds
+    for o in a.moving_obstacles:  # they pace inside the hall, away from the start at t = 0
+        for t in np.linspace(0.0, 120.0, 61):
+            p = o.position(float(t))
+            assert x0 <= p[0] <= x1 and y0 <= p[1] <= y1
+        assert np.hypot(*(o.position(0.0) - np.array(a.robot.start[:2]))) >= 2.0
