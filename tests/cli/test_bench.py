@@ -51,7 +51,9 @@ def test_bench_then_report(tmp_path, tiny, capsys, other):
     assert "path length [m]" in cap.out and other in cap.out
     # One row per number of moving obstacles, 2 successes of 2 runs; time over the lower bound
     # >= 1; no collision, none robot-caused, no timeout, no error.
-    assert re.search(r"^\s+1\s+4\.8\d\d ± 0\.000.*\s1\.\d\d\d ± \d\.\d\d\d\s+2/2\s+0\s+0\s+0\s+0$",
+    # then the minimum distance to the moving obstacles and the discomfort time.
+    assert re.search(r"^\s+1\s+4\.8\d\d ± 0\.000.*\s1\.\d\d\d ± \d\.\d\d\d\s+2/2\s+0\s+0\s+0\s+0"
+                     r"\s+-?\d+\.\d{3}\s+\d\.\d\d( ± \d\.\d\d)?$",
                      cap.out, re.M), cap.out
     md = (out / "tables.md").read_text()
     assert "| moving obstacles | path length [m]" in md

@@ -107,6 +107,7 @@ AGENTS.register("bitstar", "anyplan.agents.bitstar:BITStarAgent")
 AGENTS.register("seq-bitstar", "anyplan.agents.sequential:SequentialBITStarAgent")
 AGENTS.register("dovs", "anyplan.agents.dovs:DOVSAgent")
 AGENTS.register("st-bitstar", "anyplan.agents.spacetime:SpaceTimeBITStarAgent")
+AGENTS.register("orca", "anyplan.agents.orca:ORCAAgent")  # optional extra: pyrvo
 
 
 def make_agent(name: str, **config: Any) -> Agent:

@@ -93,7 +93,7 @@ RUN_COLUMNS: list[tuple[str, str]] = [
     ("min_clearance", "REAL"), ("collision_with", "TEXT"), ("collision_time", "REAL"),
     ("wall_time", "REAL"), ("worker", "TEXT"), ("error", "TEXT"),
     ("robot_caused", "BOOLEAN"), ("time_lower_bound", "REAL"), ("time_over_lower_bound", "REAL"),
-    ("fallbacks", "INTEGER"),
+    ("fallbacks", "INTEGER"), ("min_distance_to_moving", "REAL"), ("discomfort_time", "REAL"),
 ]
 
 _EXPERIMENT_EXTRA = [("scenario_hash", "TEXT"), ("moving_obstacles", "INTEGER"), ("suite", "TEXT"),
@@ -156,6 +156,8 @@ def run_row(result: Mapping[str, Any] | None, *, run_index: int, seed: int, scen
         "time_lower_bound": _fin(result.get("time_lower_bound_s")),
         "time_over_lower_bound": _fin(result.get("time_over_lower_bound")),
         "fallbacks": len((result.get("extra") or {}).get("fallbacks") or []),
+        "min_distance_to_moving": _fin(result.get("min_distance_to_moving_m")),
+        "discomfort_time": _fin(result.get("discomfort_time_s")),
     }
 
 

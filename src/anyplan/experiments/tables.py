@@ -92,6 +92,10 @@ class TableRow:
     time_to_goal: Stat
     robot_caused: int = 0
     time_over_bound: Stat = Stat(math.nan, math.nan, 0)
+    #: Smallest robot-to-moving-obstacle surface distance [m] over the runs, and the mean time
+    #: [s] within 0.2 m of one (discomfort).
+    min_distance_to_moving: float = math.nan
+    discomfort_time: Stat = Stat(math.nan, math.nan, 0)
 
 
 @dataclass
@@ -136,7 +140,11 @@ def summarize(runs: Sequence[Mapping[str, Any]]) -> list[PlannerTable]:
                 time_to_goal=Stat.of(r["time_to_goal"] for r in ok),
                 robot_caused=sum(bool(r.get("robot_caused")) for r in rs
                                  if r["outcome"] == "collision"),
-                time_over_bound=Stat.of(r.get("time_over_lower_bound") for r in ok)))
+                time_over_bound=Stat.of(r.get("time_over_lower_bound") for r in ok),
+                min_distance_to_moving=min((r["min_distance_to_moving"] for r in rs
+                                            if r.get("min_distance_to_moving") is not None),
+                                           default=math.nan),
+                discomfort_time=Stat.of(r.get("discomfort_time") for r in rs)))
         tables.append(t)
     order = {"seq-bitstar": 0, "bitstar": 1, "dovs": 2}
     tables.sort(key=lambda t: (order.get(t.planner, 9), t.planner, t.settings))
@@ -145,13 +153,15 @@ def summarize(runs: Sequence[Mapping[str, Any]]) -> list[PlannerTable]:
 
 HEADERS = ["moving obstacles", "path length [m]", "path generation time [s]", "time to goal [s]",
            "time / lower bound", "successes", "collisions", "robot-caused collisions", "timeouts",
-           "errors"]
+           "errors", "min distance to moving [m]", "discomfort time [s]"]
 
 
 def _cells(row: TableRow) -> list[str]:
     return [str(row.n_moving), row.path_length.fmt(3), row.generation_time.fmt(4),
             row.time_to_goal.fmt(2), row.time_over_bound.fmt(3), f"{row.successes}/{row.runs}",
-            str(row.crashes), str(row.robot_caused), str(row.timeouts), str(row.errors)]
+            str(row.crashes), str(row.robot_caused), str(row.timeouts), str(row.errors),
+            "-" if not math.isfinite(row.min_distance_to_moving) else f"{row.min_distance_to_moving:.3f}",
+            row.discomfort_time.fmt(2)]
 
 
 def _grid(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
@@ -196,7 +206,8 @@ def format_csv(tables: Sequence[PlannerTable]) -> str:
     w.writerow(["planner", "settings", "moving_obstacles", "runs", "successes", "crashes", "timeouts",
                 "errors", "path_length_mean_m", "path_length_std_m", "generation_time_mean_s",
                 "generation_time_std_s", "time_to_goal_mean_s", "time_to_goal_std_s",
-                "robot_caused_collisions", "time_over_lower_bound_mean", "time_over_lower_bound_std"])
+                "robot_caused_collisions", "time_over_lower_bound_mean", "time_over_lower_bound_std",
+                "min_distance_to_moving_m", "discomfort_time_mean_s"])
 
     def num(x: float) -> str:
         return "" if not math.isfinite(x) else f"{x:.6g}"
@@ -207,7 +218,8 @@ def format_csv(tables: Sequence[PlannerTable]) -> str:
                         r.errors, num(r.path_length.mean), num(r.path_length.std),
                         num(r.generation_time.mean), num(r.generation_time.std),
                         num(r.time_to_goal.mean), num(r.time_to_goal.std), r.robot_caused,
-                        num(r.time_over_bound.mean), num(r.time_over_bound.std)])
+                        num(r.time_over_bound.mean), num(r.time_over_bound.std),
+                        num(r.min_distance_to_moving), num(r.discomfort_time.mean)])
     return buf.getvalue()
 
 
