@@ -37,6 +37,14 @@ def test_overlapping_intervals_of_two_people_are_merged_and_spans_are_honoured()
     m = moving_obstacle_metrics(sc, _traj([(2.0, 3.0)] * 101))
     assert m["discomfort_time_s"] == pytest.approx(0.9, abs=1e-9)
     assert m["min_distance_to_moving_m"] == pytest.approx(0.05)
+    # a person who stopped 0.15 m from the robot is gone afterwards (no phantom at its last sample)
+    d["dynamic_obstacles"] = [{"name": "S", "type": "track", "radius": 0.25,
+                               "samples": [[0.0, 4.0, 3.0], [1.0, 2.7, 3.0]]}]
+    # the robot waits at x = 0.5 while S exists (until t = 1 s), then drives onto S's last spot
+    pts = [(0.5, 3.0)] * 21 + [(0.5 + 2.2 * k / 80, 3.0) for k in range(1, 81)]
+    m = moving_obstacle_metrics(scenario_from_dict(d), _traj(pts))
+    assert m["min_distance_to_moving_m"] == pytest.approx(2.2 - 0.55)
+    assert m["discomfort_time_s"] == 0.0
 
 
 def test_moving_robot_against_dense_sampling():

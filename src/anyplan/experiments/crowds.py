@@ -165,7 +165,7 @@ def _window_people(copies: list[list[tuple[str, np.ndarray]]], t0: float,
             if m.sum() < 2:
                 continue
             s = tr[m].copy()
-            s[:, 0] -= t0
+            s[:, 0] = np.maximum(s[:, 0] - t0, 0.0)  # no -1e-14 from the subtraction
             people.append((name, s))
     return people
 

@@ -52,9 +52,7 @@ def moving_obstacle_metrics(scenario: Scenario, trajectory: np.ndarray,
         a_lo, a_hi = o.motion.span
         s0 = np.clip((a_lo - t0) / h, 0.0, 1.0)     # the part of each step where it exists
         s1 = np.clip((a_hi - t0) / h, 0.0, 1.0)
-        ok = s1 > s0
-        if a_lo <= t[0] <= a_hi:
-            ok |= s1 >= s0
+        ok = (t1 >= a_lo) & (t0 <= a_hi)  # the step meets the span (touching counts)
         if not ok.any():
             continue
         A = np.einsum("ij,ij->i", dv, dv)
