@@ -48,10 +48,14 @@ class SensingSpec:
     def __post_init__(self) -> None:
         if self.mode not in MODES:
             raise ValueError(f"unknown perception mode '{self.mode}' (known: {', '.join(MODES)})")
-        if not (math.isfinite(self.noise_m) and self.noise_m >= 0.0):
-            raise ValueError(f"sensor noise must be >= 0 m, got {self.noise_m:g}")
-        if not (math.isfinite(self.rate_hz) and self.rate_hz > 0.0):
-            raise ValueError(f"sensor rate must be > 0 Hz, got {self.rate_hz:g}")
+        from anyplan.world.limits import MAX_SENSOR_RATE_HZ, MAX_SIZE_M
+
+        if not (math.isfinite(self.noise_m) and 0.0 <= self.noise_m <= MAX_SIZE_M):
+            raise ValueError(f"sensor noise must be >= 0 m and <= {MAX_SIZE_M:g} m, got "
+                             f"{self.noise_m:g}")
+        if not (math.isfinite(self.rate_hz) and 0.0 < self.rate_hz <= MAX_SENSOR_RATE_HZ):
+            raise ValueError(f"sensor rate must be > 0 Hz and <= {MAX_SENSOR_RATE_HZ:g} Hz, got "
+                             f"{self.rate_hz:g}")
 
     def to_dict(self) -> dict[str, float | str]:
         """The ``sensing:`` block of the YAML schema."""
