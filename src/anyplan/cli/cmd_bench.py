@@ -53,7 +53,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     from anyplan.cli.perception_opts import add_perception_options
 
     add_perception_options(p)
-    p.set_defaults(func=cmd_bench)
+    p.set_defaults(func=_database_errors(cmd_bench))
 
     q = sub.add_parser("bench-planning", help="anytime planning benchmark: our BIT* beside OMPL",
                        description="Plan among each scenario's static obstacles with our BIT* and "
@@ -74,7 +74,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="--suite random: see 'anyplan bench'")
     q.add_argument("--resume", action="store_true", help="run only the runs missing from --db")
     q.add_argument("--no-progress", action="store_true", help="no progress bar")
-    q.set_defaults(func=cmd_bench_planning)
+    q.set_defaults(func=_database_errors(cmd_bench_planning))
 
     r = sub.add_parser("report", help="figures, tables and an HTML report from a results database",
                        description="Read only the results database and write DIR/report.html "
@@ -82,7 +82,30 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "time, and the tables as Markdown and CSV.")
     r.add_argument("db", help="results database written by 'anyplan bench'")
     r.add_argument("--out", default="report", help="output folder (default report)")
-    r.set_defaults(func=cmd_report)
+    r.set_defaults(func=_database_errors(cmd_report))
+
+
+def _database_errors(fn):  # noqa: ANN001, ANN202
+    """A database that turns out damaged while it is read or written (past the checks made when
+    it is opened: SQLite's quick_check cannot see every corruption) ends the command with exit
+    code 2 and one line, not a traceback."""
+    import functools
+
+    @functools.wraps(fn)
+    def wrapper(args: argparse.Namespace) -> int:
+        import json
+        import sqlite3
+        import zlib
+
+        try:
+            return fn(args)
+        except (sqlite3.DatabaseError, zlib.error, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            from anyplan.errors import one_line
+
+            raise _usage(f"{args.command}: {one_line(args.db, 160)}: the database is damaged or "
+                         f"unreadable ({one_line(exc, 100)})") from None
+
+    return wrapper
 
 
 def _usage(msg: str) -> Exception:

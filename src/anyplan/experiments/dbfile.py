@@ -92,13 +92,15 @@ def check_database(path: str | Path, who: str, *, must_exist: bool = True,
             if "anyplan_meta" not in tables or "runs" not in tables:
                 raise DatabaseFileError(f"{where}: an SQLite database of another program, not an "
                                         "anyplan results database (left unchanged)")
-            ok = conn.execute("PRAGMA quick_check(1)").fetchone()
+            # Before writing, the full check (indexes against tables too); reading: the quick one.
+            check = "integrity_check(1)" if writable else "quick_check(1)"
+            ok = conn.execute(f"PRAGMA {check}").fetchone()
             if ok is None or ok[0] != "ok":
                 raise DatabaseFileError(f"{where}: the database is damaged "
                                         f"({shorten(ok[0] if ok else 'no answer', 80)})")
         finally:
             conn.close()
-    except sqlite3.DatabaseError as exc:
+    except (sqlite3.DatabaseError, UnicodeDecodeError) as exc:
         raise DatabaseFileError(f"{where}: damaged or not a database "
                                 f"({shorten(str(exc), 80).strip(chr(39))})") from None
     if writable:
