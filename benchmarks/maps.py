@@ -21,7 +21,9 @@ Sections (every time is wall-clock on a shared machine; compare within one run):
    registered) drive across the 30 m x 20 m office with walkers pacing the corridor: goal
    reached, collisions, robot-caused collisions (robot speed towards the obstacle > 0.05 m/s at
    first contact; any contact with a map cell or a wall while moving counts as robot-caused),
-   replanning time per call (median, p90).
+   replanning time per call (median, p90; wall clock, as the agents measure it), and the
+   whole runs' CPU and wall time (their ratio shows how loaded the machine was). The built-in
+   ``paper-3`` scenario runs first as the peer.
 3. **Many moving obstacles.** The same for 25, 50 and 100 pacing obstacles in a 40 m x 30 m hall
    (:mod:`anyplan.experiments.many`).
 
@@ -203,10 +205,13 @@ def _robot_caused(sc: Scenario, res: Any) -> bool | None:
 def _drive(sc: Scenario, planners: list[str], runs: int, label: str) -> list[dict[str, Any]]:
     rows = []
     for planner in planners:
-        times, reached, coll, caused, ttg = [], 0, 0, 0, []
+        times, reached, coll, caused, ttg, cpu, wall = [], 0, 0, 0, [], 0.0, 0.0
         for s in range(runs):
             gc.collect()
+            c0, w0 = time.process_time(), time.perf_counter()
             res = simulate(sc, make_agent(planner), seed=s)
+            cpu += time.process_time() - c0
+            wall += time.perf_counter() - w0
             times += res.planning_times_s[1:] if len(res.planning_times_s) > 1 else res.planning_times_s
             reached += bool(res.reached_goal)
             coll += bool(res.collision)
@@ -218,12 +223,14 @@ def _drive(sc: Scenario, planners: list[str], runs: int, label: str) -> list[dic
                "collisions": coll, "robot_caused": caused,
                "replan_ms_median": statistics.median(ms),
                "replan_ms_p90": ms[min(len(ms) - 1, int(0.9 * len(ms)))], "replans": len(times),
-               "time_to_goal_s": statistics.median(ttg) if ttg else None, "rss_mb": _rss_mb()}
+               "time_to_goal_s": statistics.median(ttg) if ttg else None, "rss_mb": _rss_mb(),
+               "run_cpu_s": cpu, "run_wall_s": wall}
         rows.append(row)
         print(f"  {label:26s} {planner:12s} reached {reached}/{runs}, collisions {coll} "
               f"(robot-caused {caused}), replanning median {row['replan_ms_median']:.1f} ms, "
               f"p90 {row['replan_ms_p90']:.1f} ms over {len(times)} calls, time to goal "
-              f"{row['time_to_goal_s'] if ttg else float('nan'):.1f} s")
+              f"{row['time_to_goal_s'] if ttg else float('nan'):.1f} s; whole runs: CPU {cpu:.1f} s "
+              f"in {wall:.1f} s wall")
     return rows
 
 
@@ -236,7 +243,8 @@ def dynamic_section(maps_dir: Path, quick: bool) -> list[dict[str, Any]]:
     print("\nwalkers in the office corridor, and many moving obstacles (first replanning, which "
           "includes the initial plan, excluded)")
     plan = roughen(office(30, 20, rng=1), 0.3, 50, rng=1)
-    rows = []
+    # peer: the paper's scenario in the same run (README: 15.3 ms median on an unloaded machine)
+    rows = _drive(load_scenario("paper-3"), planners, 1, "peer: paper-3")
     for n in (2, 4):
         path = map_scenario(plan, maps_dir, f"office-walkers-{n}", n_walkers=n, rng=n)
         rows += _drive(load_scenario(path), planners, runs, f"office-30x20 + {n} walkers")

@@ -69,6 +69,7 @@ class ObstacleSet:
         self._index = index
         if len(self.pbox) and (index or (index is None and len(self.pbox) >= MIN_INDEXED)):
             self._gmeta, self._gcsr = build_grid(self.pbox)
+            self._gmeta[6] = len(self.boxes)  # the first polygons are the boxes
         else:
             self._gmeta, self._gcsr = NO_GRID
         self._pack()

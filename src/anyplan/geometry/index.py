@@ -13,7 +13,7 @@ Examples:
     >>> boxes = np.array([[0.0, 0.0, 1.0, 1.0], [3.0, 0.0, 4.0, 0.5]])
     >>> meta, csr = build_grid(boxes, cell=1.0)
     >>> meta.tolist()
-    [0.0, 0.0, 1.0, 5.0, 2.0, 2.0]
+    [0.0, 0.0, 1.0, 5.0, 2.0, 2.0, 0.0]
     >>> cell_items(meta, csr, 0, 3).tolist()   # row 0, column 3: the second box
     [1]
 """
@@ -30,7 +30,7 @@ __all__ = ["MIN_INDEXED", "NO_GRID", "build_grid", "cell_items"]
 MIN_INDEXED = 48
 
 #: The "no index" metadata: every polygon is scanned linearly.
-NO_GRID = (np.zeros(6), np.zeros(1, dtype=np.int64))
+NO_GRID = (np.zeros(7), np.zeros(1, dtype=np.int64))
 
 
 def build_grid(pbox: np.ndarray, cell: float | None = None,
@@ -44,7 +44,7 @@ def build_grid(pbox: np.ndarray, cell: float | None = None,
         max_cells: Cap on nx * ny (default 4 P + 64); the cell grows to respect it.
 
     Returns:
-        ``gmeta`` (6,) = (x0, y0, cell, nx, ny, P) and ``gcsr`` (int64), see
+        ``gmeta`` (7,) = (x0, y0, cell, nx, ny, P, 0) and ``gcsr`` (int64), see
         :mod:`anyplan.geometry._kernels`.
     """
     b = np.asarray(pbox, dtype=float).reshape(-1, 4)
@@ -80,7 +80,7 @@ def build_grid(pbox: np.ndarray, cell: float | None = None,
     offsets = np.zeros(ncell + 1, dtype=np.int64)
     np.cumsum(np.bincount(cid, minlength=ncell), out=offsets[1:])
     gcsr = np.concatenate([offsets + (ncell + 1), item[order]]).astype(np.int64)
-    gmeta = np.array([x0, y0, h, nx, ny, n], dtype=float)
+    gmeta = np.array([x0, y0, h, nx, ny, n, 0.0], dtype=float)
     return gmeta, gcsr
 
 
