@@ -102,6 +102,6 @@ def test_valid_documents_give_a_sound_result_with_every_planner(doc, planner):
         path.write_text(yaml.safe_dump(doc, allow_unicode=True))
         out = Path(d) / "o"
         o = run_cli(["run", str(path), "--planner", planner, "--no-plot", "--out", str(out)], timeout_s=300)
-        o.err = "\n".join(ln for ln in o.err.splitlines() if "kernels" not in ln)  # the warm-up notices
+        o.err = "".join(ln + "\n" for ln in o.err.splitlines() if "kernels" not in ln)  # warm-up notices
         problem = sound_problem(o, out / "result.json", doc["time_limit"])
         assert problem is None, problem
