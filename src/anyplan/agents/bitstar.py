@@ -43,6 +43,8 @@ class BITStarAgent(Agent):
     """
 
     name = "bitstar"
+    #: Kernel parts this agent uses (:func:`~anyplan.agents.warmup.warm_up_kernels`).
+    kernel_parts = ("bitstar", "motion")
 
     def __init__(self, time_budget_s: float = 0.5, plan_margin: float = 0.03,
                  smooth_margin: float = 0.015, max_attempts: int = 3,
@@ -65,7 +67,7 @@ class BITStarAgent(Agent):
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
         from anyplan.agents.base import AgentStats
 
-        warm_up_kernels()  # compile or load machine code now, not inside the timed planning
+        warm_up_kernels(self.kernel_parts)  # compile or load now, not inside the timed planning
         self.stats = AgentStats()
         self.scenario = scenario
         self.spec = scenario.robot

@@ -85,6 +85,8 @@ class SequentialBITStarAgent(Agent):
     """
 
     name = "seq-bitstar"
+    #: Kernel parts this agent uses (:func:`~anyplan.agents.warmup.warm_up_kernels`).
+    kernel_parts = ("bitstar", "motion", "sequential")
 
     def __init__(self, config: SequentialConfig | None = None, *, plan_margin: float = 0.03,
                  smooth_margin: float = 0.015, check_period_s: float = 0.2,
@@ -115,7 +117,7 @@ class SequentialBITStarAgent(Agent):
 
     # --- lifecycle -------------------------------------------------------------------------------
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
-        warm_up_kernels()  # compile or load machine code now, not inside a timed replanning
+        warm_up_kernels(self.kernel_parts)  # compile or load now, not inside a timed replanning
         self.stats = AgentStats()
         self.spec = scenario.robot
         self.obstacles = scenario.obstacle_set()

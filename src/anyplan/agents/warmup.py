@@ -1,56 +1,118 @@
 """Loading the compiled kernels before anything is timed.
 
 anyplan's hot loops are numba functions compiled on first use and cached on disk
-(``cache=True``). The very first process on a machine compiles them (tens of seconds); later
-processes load the cached machine code (a fraction of a second). Agents call
-:func:`warm_up_kernels` in ``reset`` so that neither cost lands inside a timed planning call: a
-robot's planner is a long-lived process, and loading its code is a start-up cost, not part of
-any replanning.
+(``cache=True``). The very first process on a machine compiles them; later processes load the
+cached machine code. Agents call :func:`warm_up_kernels` in ``reset`` with the parts they use,
+so that neither cost lands inside a timed planning call: a robot's planner is a long-lived
+process, and loading its code is a start-up cost, not part of any replanning.
+
+Parts (each loads only its own kernels and those it calls):
+
+* ``"bitstar"``: BIT*'s search (batches, pruning, the blocked-edge repair);
+* ``"motion"``: the reference motion along a path (smoothing, speed profile, sampling);
+* ``"sequential"``: Sequential BIT*'s collision prediction against moving obstacles and one
+  replanning around a crossing obstacle (virtual squares, repairs, delayed departures).
+
+``on_compile`` is called once, when numba really starts compiling (a cache miss); loading
+cached code calls nothing, so a command can say "compiling" only when it is.
 """
 
 from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable, Iterable
 
 import numpy as np
 
-__all__ = ["warm_up_kernels"]
+__all__ = ["warm_up_kernels", "PARTS", "compiling_notifier"]
 
 logger = logging.getLogger(__name__)
-_DONE = False
+#: Every part, in the order they are loaded.
+PARTS = ("bitstar", "motion", "sequential")
+_DONE: set[str] = set()
 
 
-def warm_up_kernels() -> float:
-    """Compile or load every kernel the planning agents use, once per process; returns seconds."""
-    global _DONE
-    if _DONE:
-        return 0.0
-    _DONE = True
-    t0 = time.perf_counter()
-    from anyplan.geometry.collision import ObstacleSet
-    from anyplan.geometry.shapes import Circle, square
+class compiling_notifier:  # noqa: N801 - a context manager used like a function
+    """Within the ``with`` block, call ``callback()`` once at numba's first real compilation.
+
+    Attributes:
+        compiled: True once something was compiled inside the block.
+    """
+
+    def __init__(self, callback: Callable[[], None] | None) -> None:
+        self.callback = callback
+        self.compiled = False
+        self._listener = None
+
+    def __enter__(self) -> compiling_notifier:
+        from numba.core import event
+
+        notifier = self
+
+        class _First(event.Listener):
+            def on_start(self, ev: event.Event) -> None:
+                if not notifier.compiled:
+                    notifier.compiled = True
+                    if notifier.callback is not None:
+                        notifier.callback()
+
+            def on_end(self, ev: event.Event) -> None:
+                pass
+
+        self._listener = _First()
+        event.register("numba:compile", self._listener)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        from numba.core import event
+
+        event.unregister("numba:compile", self._listener)
+
+
+def _bitstar() -> None:
     from anyplan.planning.bitstar import warm_up as warm_up_bitstar
-    from anyplan.prediction.base import PredictedObstacle
-    from anyplan.prediction.collision import first_collision
-    from anyplan.trajectory.motion import plan_motion
-    from anyplan.world.motion import UnicycleMotion
-    from anyplan.world.robot import RobotSpec, RobotState
 
     warm_up_bitstar()
+
+
+def _scene():  # noqa: ANN202 - small fixture shared by the motion and sequential parts
+    from anyplan.geometry.collision import ObstacleSet
+    from anyplan.geometry.shapes import Circle, square
+    from anyplan.world.robot import RobotSpec
+
     obs = ObstacleSet([Circle((2.0, 2.0), 0.4), square((2.0, 0.9), 0.3)], bounds=(0.0, 0.0, 4.0, 4.0))
     spec = RobotSpec(start=(0.5, 0.5, 0.0), goal=(3.5, 3.5), radius=0.2)
+    return obs, spec
+
+
+def _motion() -> None:
+    from anyplan.trajectory.motion import plan_motion
+    from anyplan.world.robot import RobotState
+
+    obs, spec = _scene()
     path = np.array([[0.5, 0.5], [3.0, 1.2], [3.5, 3.5]])
     for state in (RobotState(0.5, 0.5, 0.0), RobotState(0.5, 0.5, 0.3, 0.2, 0.1)):
         traj = plan_motion(path, spec, state, obs, 0.0)
         traj.sample(np.array([0.5]))
         traj.sample(np.linspace(0.0, traj.t_end, 7))
+
+
+def _sequential() -> None:
+    from anyplan.planning.sequential import SequentialBITStar, SequentialConfig
+    from anyplan.prediction.base import PredictedObstacle
+    from anyplan.prediction.collision import first_collision
+    from anyplan.trajectory.motion import plan_motion
+    from anyplan.world.motion import UnicycleMotion
+    from anyplan.world.robot import RobotState
+
+    obs, spec = _scene()
+    path = np.array([[0.5, 0.5], [3.0, 1.2], [3.5, 3.5]])
+    traj = plan_motion(path, spec, RobotState(0.5, 0.5, 0.3, 0.2, 0.1), obs, 0.0)
     mover = PredictedObstacle("D", 0.2, UnicycleMotion(3.0, 0.5, 2.0, 0.2, 0.1))
     first_collision(traj, [mover], spec.radius, sample_dt=0.02)
     # One Sequential BIT* replanning around a crossing obstacle: virtual squares, repairs of
     # curves that cut them, delayed departures.
-    from anyplan.planning.sequential import SequentialBITStar, SequentialConfig
-
     crossing = PredictedObstacle("X", 0.2, UnicycleMotion(2.0, 0.2, 1.5708, 0.25, 0.0))
     rest = RobotState(0.5, 3.0, -0.7854)
 
@@ -61,6 +123,31 @@ def warm_up_kernels() -> float:
                              SequentialConfig(max_iterations=3, wait_delays_s=(1.0,)),
                              np.random.default_rng(0))
     loop.replan(np.array([0.5, 3.0]), np.array([3.5, 0.5]), [crossing], 0.0)
+
+
+_RUN = {"bitstar": _bitstar, "motion": _motion, "sequential": _sequential}
+
+
+def warm_up_kernels(parts: Iterable[str] = PARTS,
+                    on_compile: Callable[[], None] | None = None) -> float:
+    """Compile or load the kernels of ``parts`` (see the module docstring), each once per
+    process; returns seconds. ``on_compile`` is called once if numba compiles anything.
+
+    Raises:
+        ValueError: an unknown part.
+    """
+    todo = [p for p in PARTS if p in set(parts) and p not in _DONE]
+    unknown = set(parts) - set(PARTS)
+    if unknown:
+        raise ValueError(f"parts: unknown {sorted(unknown)} (known: {', '.join(PARTS)})")
+    if not todo:
+        return 0.0
+    t0 = time.perf_counter()
+    with compiling_notifier(on_compile) as note:
+        for p in todo:
+            _DONE.add(p)
+            _RUN[p]()
     dt = time.perf_counter() - t0
-    logger.info("compiled kernels ready in %.2f s", dt)
+    logger.info("kernels %s %s in %.2f s", "compiled" if note.compiled else "loaded",
+                ", ".join(todo), dt)
     return dt

@@ -75,8 +75,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         except ValueError as exc:
             raise UsageError(f"run: --animate: {exc}") from None
     agent = make_agent(args.planner)
-    if args.planner in ("bitstar", "seq-bitstar"):
-        _prepare_kernels()
+    _prepare_kernels(getattr(agent, "kernel_parts", ()))
     result = simulate(scenario, agent, seed=args.seed, config=cfg)
     (out / "result.json").write_text(json.dumps(result.to_dict(), indent=1))
     if not args.no_plot:
@@ -93,18 +92,27 @@ def cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _prepare_kernels() -> None:
-    """Load (or, the first time on a machine, compile) the planners' machine code up front."""
+def _prepare_kernels(parts: tuple[str, ...]) -> None:
+    """Load the machine code of the agent's kernel ``parts`` up front; only when numba really
+    compiles (the first run on a machine), say so on stderr."""
+    if not parts:
+        return
     import sys
     import time
 
     from anyplan.agents.warmup import warm_up_kernels
 
-    sys.stderr.write("anyplan: loading compiled kernels (the first run on a machine compiles "
-                     "them once, which takes a minute)\n")
+    compiled: list[bool] = []
+
+    def notice() -> None:
+        compiled.append(True)
+        sys.stderr.write("anyplan: compiling kernels for this machine (once; later runs load "
+                         "them from the cache)\n")
+
     t0 = time.perf_counter()
-    warm_up_kernels()
-    sys.stderr.write(f"anyplan: kernels ready in {time.perf_counter() - t0:.1f} s\n")
+    warm_up_kernels(parts, on_compile=notice)
+    if compiled:
+        sys.stderr.write(f"anyplan: kernels compiled in {time.perf_counter() - t0:.1f} s\n")
 
 
 def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult

@@ -185,12 +185,22 @@ def _k_nearest(v: int, P: np.ndarray, k: int, cstart: np.ndarray, citems: np.nda
         covers_all = (cx - ring <= 0 and cy - ring <= 0 and cx + ring >= ncx - 1
                       and cy + ring >= ncy - 1)
         if m >= kk:
-            order = np.argsort(dout[:m])
-            if dout[order[kk - 1]] <= ring * cell or covers_all:
-                idx = out[:m][order[:kk]].copy()
-                dd = dout[:m][order[:kk]].copy()
-                out[:kk] = idx
-                dout[:kk] = dd
+            # The kk nearest first, ascending, ties in candidate order (a partial stable
+            # selection sort, in place: out and dout are refilled if the ring grows; far
+            # cheaper to compile than np.argsort).
+            for i in range(kk):
+                j = i
+                for t in range(i + 1, m):
+                    if dout[t] < dout[j]:
+                        j = t
+                dj = dout[j]
+                oj = out[j]
+                for t in range(j, i, -1):
+                    dout[t] = dout[t - 1]
+                    out[t] = out[t - 1]
+                dout[i] = dj
+                out[i] = oj
+            if dout[kk - 1] <= ring * cell or covers_all:
                 return kk
         elif covers_all:
             return m
@@ -292,7 +302,7 @@ def _expand(v: int, P: np.ndarray, F: np.ndarray, IT: np.ndarray, ek: np.ndarray
             N[N_QUEUED] += 1
     if v == 0 and (IT[1, FLAGS] & F_VERTEX) == 0 and F[1, G_HAT] > S[S_R]:
         # Always try the direct start-goal edge, the best possible one, even beyond r.
-        es = heap_push(ek, ep, es, F[1, G_HAT], 0, 1)
+        es = heap_push(ek, ep, es, F[1, G_HAT], np.int64(0), np.int64(1))
         N[N_QUEUED] += 1
     N[N_ES] = es
 
@@ -380,7 +390,7 @@ def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np
             F[b, G_T] = gb_new
             _attach(IT, b, a)
             IT[b, EXPB] = -1
-        N[N_VS] = heap_push(vk, vp, N[N_VS], gb_new + F[b, H_HAT], b, 0)
+        N[N_VS] = heap_push(vk, vp, N[N_VS], gb_new + F[b, H_HAT], b, np.int64(0))
         if F[1, G_T] < c_best:
             S[S_CBEST] = F[1, G_T]
             return RC_IMPROVED
@@ -408,14 +418,14 @@ def start_batch(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp
             m = _near(newidx[t], P, S[S_R], cstart, citems, S, N, nb, nd)
             for u in range(m):
                 near_new[nb[u]] = True
-    vs = 0
+    vs = np.int64(0)  # not a literal: one specialisation of heap_push
     c_best = S[S_CBEST]
     for i in range(n):
         if (IT[i, FLAGS] & F_VERTEX) != 0:
             IT[i, FLAGS] |= F_OLD
             key = F[i, G_T] + F[i, H_HAT]
             if key < c_best and (near_new[i] or IT[i, EXPB] < 0):
-                vs = heap_push(vk, vp, vs, key, i, 0)
+                vs = heap_push(vk, vp, vs, key, i, np.int64(0))
     N[N_VS] = vs
 
 

@@ -170,7 +170,7 @@ def pp_eval(x: np.ndarray, c: np.ndarray, u: np.ndarray, nu: int) -> np.ndarray:
     """Derivative ``nu`` (0-3) of the curve at ``u`` (N,); shape (N, 2)."""
     n = u.shape[0]
     out = np.empty((n, 2))
-    i = 0
+    i = np.int64(0)  # not a literal: one specialisation of the callee
     for k in range(n):
         i = _locate(x, u[k], i)
         t = u[k] - x[i]
@@ -202,7 +202,7 @@ def pp_derivs(x: np.ndarray, c: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, 
     d2 = np.empty((n, 2))
     d3 = np.empty((n, 2))
     xe = x[-1]
-    i = 0
+    i = np.int64(0)  # not a literal: one specialisation of the callee
     for k in range(n):
         uk = min(max(u[k], 0.0), xe)
         i = _locate(x, uk, i)
@@ -242,7 +242,7 @@ def pp_curvature(x: np.ndarray, c: np.ndarray, u: np.ndarray) -> tuple[np.ndarra
     k = np.empty(n)
     dk = np.empty(n)
     xe = x[-1]
-    i = 0
+    i = np.int64(0)  # not a literal: one specialisation of the callee
     for j in range(n):
         uj = min(max(u[j], 0.0), xe)
         i = _locate(x, uj, i)
@@ -259,7 +259,7 @@ def abs_curvature_max(x: np.ndarray, c: np.ndarray, u: np.ndarray, fr: np.ndarra
     kk = np.empty(m)
     dd = np.empty(m)
     xe = x[-1]
-    i = 0
+    i = np.int64(0)  # not a literal: one specialisation of the callee
     for j in range(m):
         a = u[j]
         h = u[j + 1] - a
@@ -275,7 +275,7 @@ def abs_curvature_max(x: np.ndarray, c: np.ndarray, u: np.ndarray, fr: np.ndarra
         dd[j] = dmx
     if with_ends:
         prev = 0.0
-        i = 0
+        i = np.int64(0)  # not a literal: one specialisation of the callee
         for j in range(m + 1):
             uj = min(max(u[j], 0.0), xe)
             i = _locate(x, uj, i)
@@ -293,7 +293,7 @@ def gl_lengths(x: np.ndarray, c: np.ndarray, u: np.ndarray, nsub: int, gx: np.nd
     """Arc length of each interval [u_k, u_{k+1}]: ``nsub`` equal parts x 5-point Gauss."""
     m = u.shape[0] - 1
     out = np.empty(m)
-    i = 0
+    i = np.int64(0)  # not a literal: one specialisation of the callee
     for k in range(m):
         h = (u[k + 1] - u[k]) / nsub
         acc = 0.0
@@ -315,7 +315,7 @@ def hermite_u_of_s(s_grid: np.ndarray, u_grid: np.ndarray, dus: np.ndarray, leng
     """Cubic Hermite interpolation of u(s) on the grid with slopes ``dus`` (s clipped)."""
     n = s.shape[0]
     out = np.empty(n)
-    ih = 0
+    ih = np.int64(0)  # not a literal: one specialisation of the callee
     for j in range(n):
         out[j], ih = _hermite_one(s_grid, u_grid, dus, length, s[j], ih)
     return out
@@ -373,7 +373,7 @@ def chord_deviation(x: np.ndarray, c: np.ndarray, a_u: np.ndarray,
     pa = np.empty((n, 2))
     pb = np.empty((n, 2))
     dev = np.empty(n)
-    i = 0
+    i = np.int64(0)  # not a literal: one specialisation of the callee
     for j in range(n):
         pa[j, 0], pa[j, 1], pb[j, 0], pb[j, 1], dev[j], i = _chord_dev_one(x, c, a_u[j], b_u[j], i)
     return pa, pb, dev
@@ -387,7 +387,7 @@ def regular(x: np.ndarray, c: np.ndarray, u: np.ndarray, s: np.ndarray, min_spee
     th_prev = 0.0
     k_prev = 0.0
     ok = True
-    i = 0
+    i = np.int64(0)  # not a literal: one specialisation of the callee
     for j in range(n):
         ip = i
         uj = min(max(u[j], 0.0), xe)
@@ -436,8 +436,8 @@ def speed_bound(x: np.ndarray, c: np.ndarray, s_grid: np.ndarray, u_grid: np.nda
     times the interval's larger end speed."""
     best = 0.0
     xe = x[-1]
-    i = 0
-    ih = 0
+    i = np.int64(0)  # not a literal: one specialisation of the callee
+    ih = np.int64(0)  # not a literal: one specialisation of the callee
     for j in range(s.shape[0] - 1):
         h = s[j + 1] - s[j]
         px = 0.0
@@ -477,7 +477,7 @@ def curve_sample(x: np.ndarray, c: np.ndarray, s_grid: np.ndarray, u_grid: np.nd
         dt = tj - pt[i]
         vj = max(pv[i] + a * dt, 0.0)
         sj = min(ps[i] + pv[i] * dt + 0.5 * a * dt * dt, ps[i + 1])
-        uj, _ = _hermite_one(s_grid, u_grid, dus, length, sj, 0)
+        uj, _ = _hermite_one(s_grid, u_grid, dus, length, sj, np.int64(0))
         uj = min(max(uj, 0.0), xe)
         p = _piece(x, uj)
         t = uj - x[p]
@@ -613,19 +613,19 @@ def build_curve(pts: np.ndarray, mode: int, tan: np.ndarray, nrm: np.ndarray, st
     u = _cumsum0(chords)
     for _ in range(max(reparam_iters, 0)):
         bx, bc = _fit(u, pts, mode, tan, nrm, start_knot)
-        u = _cumsum0(gl_lengths(bx, bc, u, 4, gx, gw))
+        u = _cumsum0(gl_lengths(bx, bc, u, np.int64(4), gx, gw))
     bx, bc = _fit(u, pts, mode, tan, nrm, start_knot)
     n_us = np.empty(n - 1, dtype=np.int64)
     for j in range(n - 1):
         n_us[j] = max(4, int(math.ceil((u[j + 1] - u[j]) / resample_step)))
     us = subdivide(u, n_us)
-    s_of_us = _cumsum0(gl_lengths(bx, bc, us, 4, gx, gw))
+    s_of_us = _cumsum0(gl_lengths(bx, bc, us, np.int64(4), gx, gw))
     point_u = np.empty(n)
     ii = np.searchsorted(us, u)
     for j in range(n):
         point_u[j] = s_of_us[ii[j]]
-    x, c = _fit(s_of_us, pp_eval(bx, bc, us, 0), mode, tan, nrm, start_knot)
-    k_est, _ = abs_curvature_max(x, c, x, fr, False)
+    x, c = _fit(s_of_us, pp_eval(bx, bc, us, np.int64(0)), mode, tan, nrm, start_knot)
+    k_est, _ = abs_curvature_max(x, c, x, fr, np.bool_(False))
     m = x.shape[0] - 1
     n_parts = np.empty(m, dtype=np.int64)
     for j in range(m):
@@ -635,8 +635,8 @@ def build_curve(pts: np.ndarray, mode: int, tan: np.ndarray, nrm: np.ndarray, st
             p = 1.0 if p < 1.0 else 400.0
         n_parts[j] = int(min(p, 400.0))
     u_grid = subdivide(x, n_parts)
-    s_grid = _cumsum0(gl_lengths(x, c, u_grid, 1, gx, gw))
-    d1 = pp_eval(x, c, u_grid, 1)
+    s_grid = _cumsum0(gl_lengths(x, c, u_grid, np.int64(1), gx, gw))
+    d1 = pp_eval(x, c, u_grid, np.int64(1))
     dus = np.empty(u_grid.shape[0])
     for j in range(u_grid.shape[0]):
         dus[j] = 1.0 / math.hypot(d1[j, 0], d1[j, 1])
@@ -869,7 +869,7 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
     fc = np.empty(m)
     fd = np.empty(m)
     nf = 0
-    hint = 0
+    hint = np.int64(0)  # not a literal: one specialisation of the callee
     for j in range(m):
         pax, pay, pbx, pby, dev, hint = _chord_dev_one(x, c, u[j], u[j + 1], hint)
         cl = segment_clearance(pax, pay, pbx, pby, vx, vy, starts, pbox, circles, bounds, gmeta,
@@ -926,7 +926,7 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
                 continue
             w = b - a
             n_c = 0
-            h2 = 0
+            h2 = np.int64(0)  # not a literal: one specialisation of the callee
             for p in range(4):
                 a2 = a + w * (p / 4.0)
                 b2 = a + w * ((p + 1) / 4.0)
