@@ -2,15 +2,17 @@
 
 Path-velocity decomposition (see ``docs/spacetime.md``):
 
-1. BIT* plans a path among the static obstacles; :func:`~anyplan.trajectory.plan_motion` smooths
+1. At a replanning, the path in use is tried first, from the robot's new state (steps 2 and 4,
+   no search). Otherwise BIT* plans a path among the static obstacles; :func:`~anyplan.trajectory.plan_motion` smooths
    it into a reference motion within v, omega, a and alpha.
 2. The curve is **re-timed** (:func:`anyplan.trajectory.spacetime.retime`): the earliest
    acceleration-bounded motion along it that avoids the s-t regions of the predicted discs, so
    the robot may slow down, wait and pass behind an obstacle.
-3. If no timing gets through within ``patience_s`` of the path's own arrival, a virtual square
-   is put where the untimed motion meets the obstacle, as Sequential BIT* does, and the detour
-   BIT* then finds is timed the same way (up to ``config.max_iterations`` paths); the first
-   path that can be timed is taken. If none can, the shortest and the last path are timed
+3. Unless the timing arrives within ``accept_s`` of the path's own (untimed) arrival, a virtual
+   square is put where the untimed motion meets the obstacle, as Sequential BIT* does, and the
+   detour BIT* then finds is timed the same way (up to ``config.max_iterations`` paths, each
+   timed with waits up to ``patience_s``); the earliest arrival among the timed candidates
+   wins. If none can be timed, the shortest and the last path are timed
    again allowing waits up to ``max_wait_s``, and the earlier arrival wins.
 4. Every motion is verified with the certified continuous check
    (:func:`anyplan.trajectory.spacetime.verify`) before it is executed. When no candidate is
@@ -67,6 +69,20 @@ def warm_up_spacetime() -> None:
         verify(res.trajectory, [mover], spec.radius)
 
 
+def _remaining(path: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The part of ``path`` (N, 2) after the point of it nearest to ``p``, starting at ``p``."""
+    a, b = path[:-1], path[1:]
+    ab = b - a
+    den = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-18)
+    u = np.clip(np.einsum("ij,ij->i", p - a, ab) / den, 0.0, 1.0)
+    d = np.hypot(*(a + u[:, None] * ab - p).T)
+    k = int(np.argmin(d))
+    rest = path[k + 1:]
+    if len(rest) and float(np.hypot(*(rest[0] - p))) < 1e-6:
+        rest = rest[1:]
+    return np.vstack([p, rest]) if len(rest) else np.vstack([p, path[-1:]])
+
+
 class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     """BIT* candidate paths, each timed among the moving obstacles (s-t velocity planning).
 
@@ -74,8 +90,10 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         config: The Sequential BIT* loop that supplies candidate paths (detours around virtual
             squares); its ``margin`` [m] is the clearance kept from the moving obstacles.
         patience_s: First, each candidate path is timed with arrivals up to this much [s] after
-            its untimed motion; the first that succeeds is taken (shorter searches, and a detour
-            is preferred to a long wait).
+            its untimed motion (short searches; a detour may beat a long wait).
+        accept_s: A timed path arriving at most this much [s] after its untimed motion ends the
+            search for detours at once; slower ones are kept, and the earliest arrival among all
+            timed candidates wins.
         max_wait_s: When no path can be timed within ``patience_s``, the first and the last
             path are timed again with delays up to this much [s], and the earlier arrival wins.
         lattice_dt_s: Approximate step [s] of the velocity lattice.
@@ -85,12 +103,16 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     name = "st-bitstar"
 
     def __init__(self, config: SequentialConfig | None = None, *, patience_s: float = 3.0,
-                 max_wait_s: float = 30.0, lattice_dt_s: float = 0.25, **kwargs: Any) -> None:
+                 max_wait_s: float = 30.0, lattice_dt_s: float = 0.25, accept_s: float = 0.5,
+                 **kwargs: Any) -> None:
         super().__init__(config if config is not None else _DEFAULT_LOOP, **kwargs)
         for name, val in (("patience_s", patience_s), ("max_wait_s", max_wait_s),
                           ("lattice_dt_s", lattice_dt_s)):
             if not (isinstance(val, int | float) and val > 0.0):
                 raise ValueError(f"{name}: must be > 0, got {val!r}")
+        if not (isinstance(accept_s, int | float) and 0.0 <= accept_s <= patience_s):
+            raise ValueError(f"accept_s: must be in [0, patience_s], got {accept_s!r}")
+        self.accept_s = float(accept_s)
         self.patience_s = float(patience_s)
         self.max_wait_s = float(max_wait_s)
         self.lattice_dt_s = float(lattice_dt_s)
@@ -100,6 +122,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         super().reset(scenario, rng)
         self._cands: list[tuple[float, Trajectory, np.ndarray, list[Shape]]] = []
         self._tried: list[tuple[np.ndarray, list[Shape]]] = []
+        self._path: np.ndarray | None = None
+        self._shapes: list[Shape] = []
         self._preds: list[PredictedObstacle] = []
         ex = self.stats.extra
         ex.update({"fallbacks": [], "st_waits_s": [], "st_timed": 0, "st_candidates": []})
@@ -113,6 +137,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             if delay == 0.0:
                 self._tried.append((np.asarray(path), list(shapes)))
             nominal = nominal_fn(path, shapes, delay)
+            if not nominal.certified_free:
+                return nominal  # a best effort that cuts an obstacle: never a candidate
             if delay > 0.0 or not self._preds:
                 if not self._preds:
                     self._cands.append((nominal.t_end, nominal, np.asarray(path), list(shapes)))
@@ -126,7 +152,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                       t_until=tr.t_end - self._tail_time(tr)) is not None:
                 return nominal
             self._cands.append((tr.t_end, tr, np.asarray(path), list(shapes)))
-            return tr
+            # Taken at once (the loop stops) if it is about as fast as the untimed motion;
+            # otherwise kept while the loop looks for a detour that arrives earlier.
+            return tr if res.delay_s <= self.accept_s else nominal
 
         return build
 
@@ -165,9 +193,19 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         self._tried = []
         self._preds = list(preds)
         w0 = time.perf_counter()
-        res: SequentialResult = self.loop.replan(np.array([state.x, state.y]),
-                                                 np.asarray(self.spec.goal, dtype=float), preds, t,
-                                                 self._timed_fn(state, t_ready, self.patience_s))
+        res: SequentialResult | None = None
+        if self._path is not None and len(self._path) >= 2:
+            # First the path in use, from where the robot will be: no new search if it can be
+            # timed within patience_s.
+            rest = _remaining(self._path, np.array([state.x, state.y]))
+            self._timed_fn(state, t_ready, self.patience_s)(rest, self._shapes, 0.0)
+            self._tried = []
+            if self._cands:
+                res = SequentialResult("collision_free", rest, self._cands[0][1], [], 0)
+        if res is None:
+            res = self.loop.replan(np.array([state.x, state.y]),
+                                   np.asarray(self.spec.goal, dtype=float), preds, t,
+                                   self._timed_fn(state, t_ready, self.patience_s))
         if not self._cands and self._tried:
             # No short timing: allow long waits on the shortest path and on the last detour.
             build = self._timed_fn(state, t_ready, self.max_wait_s)
@@ -214,6 +252,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 return  # the current reference is still free: keep it, try again later
             motion = self._fallback(obs, t_switch, preds, res.status)
         else:
+            self._path, self._shapes = np.asarray(path), list(shapes)
             ex["st_timed"] += int(motion.kind.startswith("st+"))
             ex["st_waits_s"].append(float(motion.info.get("wait_s", 0.0)))
         st.plans.append({"t": t, "t_start": t_switch, "path": np.asarray(path).tolist(),

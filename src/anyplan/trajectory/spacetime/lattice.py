@@ -246,7 +246,7 @@ def _search(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap0: np.
 def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap0: np.ndarray,
                   xcap1: np.ndarray, length: float, t0: float, v0: float, a_max: float,
                   v_max: float, *, target_dt: float = 0.25, horizon_s: float = 60.0,
-                  key_cells: int = 2) -> VelocityPlan | None:
+                  key_cells: int = 4) -> VelocityPlan | None:
     """The earliest lattice motion from (t0, s=0, v0) to rest at (about) the path's end.
 
     Args:

@@ -33,6 +33,7 @@ from numba import njit
 __all__ = ["STMap", "build_stmap", "radii_at"]
 
 _CHUNK = 16  # path cells per bounding circle of the coarse test
+_BLOCK = 16  # map rows per block of the coarse test
 
 
 def radii_at(obstacle: Any, t: np.ndarray) -> np.ndarray:
@@ -46,23 +47,42 @@ def radii_at(obstacle: Any, t: np.ndarray) -> np.ndarray:
 
 @njit(cache=True)
 def _fill(out: np.ndarray, px: np.ndarray, py: np.ndarray, cx: np.ndarray, cy: np.ndarray,
-          crad: np.ndarray, qx: np.ndarray, qy: np.ndarray, reach: np.ndarray, chunk: int,
-          n_free: int) -> None:
-    """Mark the cells (j, c) with |P_c - Q_j| <= reach_j; cells c >= n_free stay free."""
+          crad: np.ndarray, qx: np.ndarray, qy: np.ndarray, reach: np.ndarray, spread: np.ndarray,
+          chunk: int, n_free: int) -> np.ndarray:
+    """Mark the cells (j, c) with |P_c - Q_oj| <= reach_oj for every obstacle o (rows of q, reach);
+    cells c >= n_free stay free; ``spread[o]`` bounds how far [m] obstacle o moves per row (blocks
+    of rows far from a chunk of cells are skipped at once). Returns, per obstacle, whether it
+    marked a cell."""
     nrow = out.shape[0]
     ncell = min(out.shape[1], n_free)
-    for j in range(nrow):
-        r = reach[j]
-        r2 = r * r
-        for g in range(cx.shape[0]):
-            if math.hypot(qx[j] - cx[g], qy[j] - cy[g]) - crad[g] > r:
-                continue
-            c1 = min((g + 1) * chunk, ncell)
-            for c in range(g * chunk, c1):
-                dx = px[c] - qx[j]
-                dy = py[c] - qy[j]
-                if dx * dx + dy * dy <= r2:
-                    out[j, c] = True
+    hit = np.zeros(qx.shape[0], dtype=np.bool_)
+    nb = (nrow + _BLOCK - 1) // _BLOCK
+    for o in range(qx.shape[0]):
+        for b in range(nb):
+            j0, j1 = b * _BLOCK, min((b + 1) * _BLOCK, nrow)
+            jm = (j0 + j1) // 2
+            # every row of the block is within spread[o] * (rows apart) of the middle row
+            rb = 0.0
+            for j in range(j0, j1):
+                rb = max(rb, reach[o, j])
+            rb += spread[o] * max(jm - j0, j1 - 1 - jm)
+            for g in range(cx.shape[0]):
+                if math.hypot(qx[o, jm] - cx[g], qy[o, jm] - cy[g]) - crad[g] > rb:
+                    continue
+                c1 = min((g + 1) * chunk, ncell)
+                for j in range(j0, j1):
+                    r = reach[o, j]
+                    x, y = qx[o, j], qy[o, j]
+                    if math.hypot(x - cx[g], y - cy[g]) - crad[g] > r:
+                        continue
+                    r2 = r * r
+                    for c in range(g * chunk, c1):
+                        dx = px[c] - x
+                        dy = py[c] - y
+                        if dx * dx + dy * dy <= r2:
+                            out[j, c] = True
+                            hit[o] = True
+    return hit
 
 
 class STMap:
@@ -74,7 +94,7 @@ class STMap:
         h: Row duration [s].
         ds: Cell width [m].
         length: Path length [m].
-        blockers: Names of the obstacles that come near the path (they may mark cells).
+        blockers: Names of the obstacles that mark at least one cell.
     """
 
     def __init__(self, forbidden: np.ndarray, t_map: float, h: float, ds: float, length: float,
@@ -114,17 +134,20 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     p = np.asarray(points_at(sc), dtype=float).reshape(-1, 2)
     px, py = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
     ng = int(math.ceil(ncell / _CHUNK))
-    cx, cy, crad = np.empty(ng), np.empty(ng), np.empty(ng)
-    for g in range(ng):
-        sl = slice(g * _CHUNK, min((g + 1) * _CHUNK, ncell))
-        cx[g], cy[g] = px[sl].mean(), py[sl].mean()
-        crad[g] = float(np.max(np.hypot(px[sl] - cx[g], py[sl] - cy[g])))
+    pad = np.full(ng * _CHUNK, np.nan)
+    gxs, gys = pad.copy(), pad.copy()
+    gxs[:ncell], gys[:ncell] = px, py
+    gxs, gys = gxs.reshape(ng, _CHUNK), gys.reshape(ng, _CHUNK)
+    cx, cy = np.nanmean(gxs, axis=1), np.nanmean(gys, axis=1)
+    crad = np.nanmax(np.hypot(gxs - cx[:, None], gys - cy[:, None]), axis=1)
     n_free = int(math.floor(max(length - free_tail_m, 0.0) / ds)) if free_tail_m > 0.0 else ncell
     gx, gy = float(px.mean()), float(py.mean())
     grad = float(np.max(np.hypot(px - gx, py - gy)))
     t_edges = t_map + h * np.arange(nrow + 1)
     t_mid = t_map + h * (np.arange(nrow) + 0.5)
-    blockers: list[str] = []
+    near: list[Any] = []
+    qs: list[np.ndarray] = []
+    reaches: list[np.ndarray] = []
     for o in obstacles:
         q = np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2)
         r_mid = radii_at(o, t_mid)
@@ -133,7 +156,14 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
         reach = robot_radius + r_max + margin + 0.5 * ds + 0.5 * float(o.max_speed) * h
         if float(np.min(np.hypot(q[:, 0] - gx, q[:, 1] - gy) - grad - reach)) > 0.0:
             continue  # never near the path
-        _fill(out, px, py, cx, cy, crad, np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(q[:, 1]),
-              np.ascontiguousarray(reach), _CHUNK, n_free)
-        blockers.append(str(o.name))
+        near.append(o)
+        qs.append(q)
+        reaches.append(reach)
+    blockers: list[str] = []
+    if near:
+        q_all = np.stack(qs)
+        hit = _fill(out, px, py, cx, cy, crad, np.ascontiguousarray(q_all[:, :, 0]),
+                    np.ascontiguousarray(q_all[:, :, 1]), np.ascontiguousarray(np.stack(reaches)),
+                    np.array([float(o.max_speed) * h for o in near]), _CHUNK, n_free)
+        blockers = [str(o.name) for o, hh in zip(near, hit, strict=True) if hh]
     return STMap(out, t_map, h, ds, length, blockers)

@@ -1,0 +1,203 @@
+"""OMPL's STRRT* (Grothe et al., ICRA 2022) as an offline peer of ``st-bitstar``.
+
+STRRT* plans in (x, y, t) for a holonomic point robot with |v| <= v_max and no acceleration
+limit, minimising the arrival time (``ob.MinimizeArrivalTime``). We give it the scenario's
+static obstacles and the *true* motions of the moving obstacles (the paper's assumption: motion
+known), with exact validity checking:
+
+* a state (x, y, t) is valid when the robot's disc is free of every static shape and wall and
+  of every moving disc at time t;
+* a motion between two states is valid when time increases, the speed is at most v_max, the
+  segment is free of the static obstacles (exact segment clearance) and the robot moving on it
+  at constant velocity never touches a moving disc (the certified continuous contact search of
+  :func:`anyplan.geometry.first_contact`).
+
+Only the ``ompl`` 1.7 wheels expose STRRT*, ``SpaceTimeStateSpace`` and ``MinimizeArrivalTime``
+(``pip install 'anyplan[strrt]'``; the 2.0 wheels of the ``bench`` extra do not). The wheel has
+two traps: ``ompl`` must be imported after numpy, and the interpreter may crash at exit; so each
+problem is solved in a fresh subprocess (``python -m anyplan.experiments.strrt``, problem as JSON
+on stdin, answer as one JSON line on stdout) that leaves with ``os._exit``. ``site`` adds a
+directory to that subprocess's ``PYTHONPATH`` (e.g. a ``pip install --target`` of the 1.7 wheel
+next to a 2.0 install).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+from typing import Any
+
+from anyplan.world.scenario import Scenario
+
+__all__ = ["strrt_available", "solve_strrt"]
+
+
+def _env(site: str | None) -> dict[str, str]:
+    env = dict(os.environ)
+    if site:
+        env["PYTHONPATH"] = site + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    return env
+
+
+def strrt_available(site: str | None = None) -> bool:
+    """True if a subprocess can import ``ompl`` with ``og.STRRTstar`` (1.7 wheels)."""
+    code = ("import numpy, os\n"
+            "try:\n from ompl import base as ob, geometric as og\n"
+            " ok = hasattr(og, 'STRRTstar') and hasattr(ob, 'SpaceTimeStateSpace')\n"
+            "except Exception:\n ok = False\n"
+            "print('yes' if ok else 'no', flush=True)\nos._exit(0)\n")
+    try:
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                             timeout=60, env=_env(site))
+    except (OSError, subprocess.TimeoutExpired):
+        return False
+    return out.stdout.strip().endswith("yes")
+
+
+def solve_strrt(scenario: Scenario, budget_s: float, seed: int = 0, site: str | None = None,
+                timeout_s: float | None = None) -> dict[str, Any]:
+    """Solve ``scenario`` offline with STRRT* for ``budget_s`` seconds in a subprocess.
+
+    Returns:
+        ``{solved, arrival_s (at the goal centre), goal_edge_s (first time within the goal
+        tolerance), path_length_m, path: [[x, y, t], ...], solve_time_s}``, or
+        ``{solved: False, error}`` if the subprocess failed.
+    """
+    problem = {"scenario": scenario.to_dict(), "budget_s": float(budget_s), "seed": int(seed)}
+    try:
+        out = subprocess.run([sys.executable, "-m", "anyplan.experiments.strrt"],
+                             input=json.dumps(problem), capture_output=True, text=True,
+                             timeout=timeout_s or (budget_s * 3 + 60), env=_env(site))
+    except subprocess.TimeoutExpired:
+        return {"solved": False, "error": "timeout"}
+    for line in reversed(out.stdout.strip().splitlines()):
+        if line.startswith("{"):
+            return json.loads(line)
+    return {"solved": False, "error": (out.stderr.strip().splitlines() or ["no output"])[-1]}
+
+
+def _worker(problem: dict[str, Any]) -> dict[str, Any]:  # pragma: no cover - runs in a subprocess
+    import time
+
+    import numpy as np
+
+    from anyplan.geometry.moving import first_contact
+    from anyplan.world.scenario import scenario_from_dict
+
+    from ompl import base as ob  # after numpy (see the module docstring)
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    sc = scenario_from_dict(problem["scenario"], "<strrt problem>")
+    r = sc.robot
+    statics = sc.obstacle_set()
+    movers = [(o.motion, o.radius) for o in sc.moving_obstacles]
+    ou.RNG.setSeed(int(problem["seed"]) + 1)
+    ou.setLogLevel(ou.LOG_NONE)
+    vs = ob.RealVectorStateSpace(2)
+    b = ob.RealVectorBounds(2)
+    x0, y0, x1, y1 = sc.bounds
+    b.setLow(0, x0)
+    b.setHigh(0, x1)
+    b.setLow(1, y0)
+    b.setHigh(1, y1)
+    vs.setBounds(b)
+    space = ob.SpaceTimeStateSpace(vs, r.v_max)
+    space.setTimeBounds(0.0, float(sc.time_limit))
+    space.updateEpsilon()
+    si = ob.SpaceInformation(space)
+
+    def xyt(s: Any) -> tuple[float, float, float]:
+        return float(s[0][0]), float(s[0][1]), float(space.getStateTime(s))
+
+    def valid(s: Any) -> bool:
+        x, y, t = xyt(s)
+        if t < 0.0 or not statics.point_free((x, y), r.radius):
+            return False
+        ta = np.array([t])
+        return all(math.hypot(*(m.positions(ta)[0] - (x, y))) > r.radius + rad for m, rad in movers)
+
+    class Exact(ob.MotionValidator):
+        def checkMotion(self, s1: Any, s2: Any) -> bool:  # noqa: N802 - OMPL's name
+            if not valid(s2):
+                return False
+            xa, ya, ta = xyt(s1)
+            xb, yb, tb = xyt(s2)
+            if tb <= ta:
+                return False
+            d = math.hypot(xb - xa, yb - ya)
+            v = d / (tb - ta)
+            if v > r.v_max * (1.0 + 1e-9):
+                return False
+            if d > 0.0 and not statics.segment_free((xa, ya), (xb, yb), r.radius):
+                return False
+            pa, pb = np.array([xa, ya]), np.array([xb, yb])
+
+            def robot(t: np.ndarray) -> np.ndarray:
+                u = ((np.asarray(t, dtype=float) - ta) / (tb - ta))[:, None]
+                return pa + u * (pb - pa)
+
+            for m, rad in movers:
+                if first_contact(robot, m.positions, v + m.max_speed, r.radius + rad, ta, tb,
+                                 tol=1e-4) is not None:
+                    return False
+            return True
+
+    si.setStateValidityChecker(ob.StateValidityCheckerFn(valid))
+    mv = Exact(si)
+    si.setMotionValidator(mv)
+    si.setup()
+    start, goal = ob.State(space), ob.State(space)
+    start()[0][0], start()[0][1] = r.start[0], r.start[1]
+    goal()[0][0], goal()[0][1] = r.goal[0], r.goal[1]
+    pdef = ob.ProblemDefinition(si)
+    pdef.setStartAndGoalStates(start, goal)
+    pdef.setOptimizationObjective(ob.MinimizeArrivalTime(si))
+    planner = og.STRRTstar(si)
+    planner.setRange(r.v_max)
+    planner.setProblemDefinition(pdef)
+    planner.setup()
+    t0 = time.perf_counter()
+    planner.solve(float(problem["budget_s"]))
+    spent = time.perf_counter() - t0
+    if not pdef.hasExactSolution():
+        return {"solved": False, "solve_time_s": spent}
+    path = pdef.getSolutionPath()
+    pts = [list(xyt(path.getState(i))) for i in range(path.getStateCount())]
+    p = np.array(pts)
+    length = float(np.sum(np.hypot(*np.diff(p[:, :2], axis=0).T)))
+    edge = p[-1, 2]
+    for (xa, ya, ta), (xb, yb, tb) in zip(pts[:-1], pts[1:], strict=True):
+        # first time along the path within the goal tolerance (solve on the segment)
+        da, db = math.hypot(xa - r.goal[0], ya - r.goal[1]), math.hypot(xb - r.goal[0], yb - r.goal[1])
+        if db <= r.goal_tolerance:
+            if da <= r.goal_tolerance:
+                edge = ta
+                break
+            lo, hi = 0.0, 1.0
+            for _ in range(50):
+                mid = 0.5 * (lo + hi)
+                q = (xa + mid * (xb - xa), ya + mid * (yb - ya))
+                if math.hypot(q[0] - r.goal[0], q[1] - r.goal[1]) <= r.goal_tolerance:
+                    hi = mid
+                else:
+                    lo = mid
+            edge = ta + hi * (tb - ta)
+            break
+    return {"solved": True, "arrival_s": float(p[-1, 2]), "goal_edge_s": float(edge),
+            "path_length_m": length, "path": pts, "solve_time_s": spent}
+
+
+if __name__ == "__main__":  # pragma: no cover - the subprocess
+    import numpy  # noqa: F401 - before ompl
+
+    try:
+        answer = _worker(json.loads(sys.stdin.read()))
+    except Exception as exc:  # report, never hang the caller
+        answer = {"solved": False, "error": f"{type(exc).__name__}: {exc}"}
+    sys.stdout.write(json.dumps(answer) + "\n")
+    sys.stdout.flush()
+    os._exit(0)
