@@ -143,6 +143,11 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 if not self._preds:
                     self._cands.append((nominal.t_end, nominal, np.asarray(path), list(shapes)))
                 return nominal
+            if verify(nominal, self._preds, spec.radius, margin=cfg.margin,
+                      t_until=nominal.t_end) is None:
+                # Already free as timed for the static world (time-optimal): nothing to re-time.
+                self._cands.append((nominal.t_end, nominal, np.asarray(path), list(shapes)))
+                return nominal
             res = retime(nominal, self._preds, spec, margin=cfg.margin, max_wait_s=max_wait_s,
                          target_dt=self.lattice_dt_s, free_tail_m=0.5 * spec.goal_tolerance)
             tr = res.trajectory
