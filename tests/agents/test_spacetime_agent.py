@@ -109,3 +109,21 @@ def test_result_fields():
 def test_bad_options():
     with pytest.raises(ValueError, match="patience_s"):
         make_agent("st-bitstar", patience_s=0.0)
+
+
+@pytest.mark.slow
+def test_holds_and_records_a_fallback_when_nothing_is_safe():
+    # A 1.2 m corridor and an obstacle coming head-on along it: no motion avoids it.
+    sc = scenario_from_dict({
+        "name": "corridor", "time_limit": 20.0, "arena": {"width": 8.0, "height": 1.2},
+        "robot": {"start": [1.0, 0.6, 0.0], "goal": [7.0, 0.6], **P3DX},
+        "static_obstacles": [],
+        "dynamic_obstacles": [{"name": "H", "start": [6.0, 0.6, math.pi], "v": 0.3,
+                               "radius": 0.3}]})
+    r = simulate(sc, make_agent("st-bitstar", planning_delay=0.1), seed=0)
+    fb = r.extra["fallbacks"]
+    assert fb and all(f["kind"] == "brake-hold" for f in fb)
+    assert r.plans[0]["kind"] == "fallback-hold"
+    # The robot never drove towards the obstacle: it is hit while at rest (not robot-caused).
+    tr = r.trajectory_array
+    assert np.max(np.abs(tr[:, 4])) < 0.05

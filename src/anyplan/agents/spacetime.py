@@ -47,6 +47,8 @@ __all__ = ["SpaceTimeBITStarAgent"]
 
 _DEFAULT_LOOP = SequentialConfig(max_iterations=8, wait_delays_s=(), max_time_s=0.3)
 _WARM = False
+#: How far ahead [s] a motion in use is checked (a hold lasts "for ever").
+_CHECK_HORIZON_S = 60.0
 
 
 def warm_up_spacetime() -> None:
@@ -252,8 +254,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                     motion = self._cands[0][1]
             st.planning_times_s[-1] = wall + (time.perf_counter() - w1)
         if motion is None:
-            if self.trajectory is not None and verify(self.trajectory, preds, self.spec.radius,
-                                                      t_from=t_switch) is None:
+            if self.trajectory is not None and verify(
+                    self.trajectory, preds, self.spec.radius, t_from=t_switch,
+                    t_until=min(self.trajectory.t_end, t_switch + _CHECK_HORIZON_S)) is None:
                 return  # the current reference is still free: keep it, try again later
             motion = self._fallback(obs, t_switch, preds, res.status)
         else:
@@ -281,7 +284,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         if traj.kind == "fallback-hold" and t - self._last_replan >= self.min_replan_interval_s:
             self._replan(obs, preds, "holding")
             return
-        hit = verify(traj, preds, spec.radius, t_from=t, t_until=max(traj.t_end, t) + 1.0,
+        hit = verify(traj, preds, spec.radius, t_from=t,
+                     t_until=min(max(traj.t_end, t) + 1.0, t + _CHECK_HORIZON_S),
                      margin=0.5 * self.config.margin)
         if hit is None:
             return
