@@ -3,7 +3,8 @@
 Path-velocity decomposition (see ``docs/spacetime.md``):
 
 1. At a replanning, the path in use is tried first, from the robot's new state (steps 2 and 4,
-   no search). Otherwise BIT* plans a path among the static obstacles; :func:`~anyplan.trajectory.plan_motion` smooths
+   no search when its timing is within ``accept_s`` of its untimed arrival; a slower timing
+   stays a candidate). Otherwise BIT* plans a path among the static obstacles; :func:`~anyplan.trajectory.plan_motion` smooths
    it into a reference motion within v, omega, a and alpha.
 2. The curve is **re-timed** (:func:`anyplan.trajectory.spacetime.retime`): the earliest
    acceleration-bounded motion along it that avoids the s-t regions of the predicted discs, so
@@ -205,10 +206,12 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             # First the path in use, from where the robot will be: no new search if it can be
             # timed within patience_s.
             rest = _remaining(self._path, np.array([state.x, state.y]))
-            self._timed_fn(state, t_ready, self.patience_s)(rest, self._shapes, 0.0)
+            out = self._timed_fn(state, t_ready, self.patience_s)(rest, self._shapes, 0.0)
             self._tried = []
-            if self._cands:
-                res = SequentialResult("collision_free", rest, self._cands[0][1], [], 0)
+            if self._cands and out is self._cands[-1][1]:
+                # as fast as untimed (within accept_s): no search; a slower timing stays a
+                # candidate against the loop's paths below
+                res = SequentialResult("collision_free", rest, out, [], 0)
         if res is None:
             res = self.loop.replan(np.array([state.x, state.y]),
                                    np.asarray(self.spec.goal, dtype=float), preds, t,
