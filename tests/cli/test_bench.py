@@ -76,7 +76,7 @@ def test_bench_then_report(tmp_path, tiny, capsys, other):
     imgs = re.findall(r"src='data:image/png;base64,([^']+)'", page)
     assert len(imgs) == 2 + has_progress
     assert all(base64.b64decode(b)[:8] == b"\x89PNG\r\n\x1a\n" for b in imgs)
-    assert other in page and "<table>" in page
+    assert other in page and "<table class='sortable'>" in page
 
 
 def test_bench_resume_flag_and_refusal(tmp_path, tiny, capsys):

@@ -25,7 +25,7 @@ def test_dovs_plot_at_time_zero(tmp_path) -> None:
     (["dovs-plot", "paper-1", "--time", "-1"], "--time"),
     (["dovs-plot", "paper-1", "--time", "nan"], "--time"),
     (["dovs-plot", "paper-1", "--time", "1e6"], "time limit"),
-    (["dovs-plot", "paper-1", "--time", "1", "--out", "x.pdf"], ".png"),
+    (["dovs-plot", "paper-1", "--time", "1", "--out", "x.gif"], ".png, .svg or .pdf"),
     (["dovs-plot", "paper-1", "--time", "1", "--set", "bogus=1"], "bogus"),
     (["dovs-plot", "paper-1", "--time", "1", "--set", "d_safe=-1"], "DOVSConfig.d_safe"),
     (["dovs-plot", "no-such-scenario", "--time", "1"], "no-such-scenario"),

@@ -78,10 +78,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     r = sub.add_parser("report", help="figures, tables and an HTML report from a results database",
                        description="Read only the results database and write DIR/report.html "
-                       "(self-contained), the paper's Figure 4 grid, box plots, cost against "
-                       "time, and the tables as Markdown and CSV.")
+                       "(one self-contained, interactive page: navigation, sortable tables, plots, "
+                       "drill-down from each number to its runs and a playback of each run), the "
+                       "paper's Figure 4 grid, box plots, cost against time, and the tables as "
+                       "Markdown and CSV.")
     r.add_argument("db", help="results database written by 'anyplan bench'")
     r.add_argument("--out", default="report", help="output folder (default report)")
+    r.add_argument("--format", default="png", choices=("png", "svg", "pdf"),
+                   help="format of the figures (default png; report.html embeds them as PNG)")
     r.set_defaults(func=_database_errors(cmd_report))
 
 
@@ -231,7 +235,7 @@ def cmd_report(args: argparse.Namespace) -> int:
     from anyplan.viz.report import build_report
 
     try:
-        paths = build_report(db, args.out)
+        paths = build_report(db, args.out, fmt=args.format)
     except OSError as exc:
         raise _usage(f"report: --out {args.out}: cannot write ({exc.strerror})") from None
     for p in paths:

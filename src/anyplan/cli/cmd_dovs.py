@@ -4,10 +4,8 @@ from __future__ import annotations
 
 import argparse
 import math
-from pathlib import Path
 
 from anyplan.cli import checks
-from anyplan.errors import shorten
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -22,8 +20,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--time", type=float, required=True, metavar="T",
                    help="simulated time [s] at which to draw the decision (>= 0)")
     p.add_argument("--seed", type=checks.seed, default=0, help="random seed >= 0 (default 0)")
-    p.add_argument("--out", default=None, metavar="FILE.png",
-                   help="output picture (default runs/dovs-SCENARIO-tT.png)")
+    p.add_argument("--out", default=None, metavar="FILE",
+                   help="output picture, .png, .svg or .pdf (default runs/dovs-SCENARIO-tT.png)")
+    p.add_argument("--format", default=None, choices=("png", "svg", "pdf"),
+                   help="picture format (default: the suffix of --out, else png)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="params",
                    help="override a DOVSConfig parameter, e.g. --set time_horizon_s=6 (repeatable)")
     p.set_defaults(func=cmd_dovs_plot)
@@ -75,10 +75,10 @@ def cmd_dovs_plot(args: argparse.Namespace) -> int:
     if t_req > scenario.time_limit:
         raise UsageError(f"dovs-plot: --time {t_req:g} s is beyond the scenario's time limit "
                          f"({scenario.time_limit:g} s)")
-    out = Path(args.out or f"runs/dovs-{checks.safe_name(scenario.name)}-t{t_req:g}.png")
-    if out.suffix.lower() != ".png":
-        raise UsageError(f"dovs-plot: --out {shorten(str(out), 120)}: the picture must be "
-                         "a .png file")
+    from anyplan.cli.pictures import picture_path
+
+    default = f"runs/dovs-{checks.safe_name(scenario.name)}-t{t_req:g}.{args.format or 'png'}"
+    out = picture_path(args.out or default, args.format, "dovs-plot", "--out")
     checks.writable_file(out, "dovs-plot: --out")
     agent = DOVSAgent(**_parse_params(args.params))
 

@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 from anyplan.cli import checks
+from anyplan.cli.pictures import picture_path
 from anyplan.planning.api import PLANNERS
 
 DEFAULT_TIME_S = 1.0
@@ -26,7 +27,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=checks.seed, default=0, help="random seed >= 0 (default 0)")
     p.add_argument("--json", default=None, metavar="FILE", help="write the result as JSON")
     p.add_argument("--plot", default=None, metavar="FILE",
-                   help="write a picture (tree, samples, informed ellipse, path)")
+                   help="write a picture (tree, samples, informed ellipse, path): .png, .svg or .pdf")
+    p.add_argument("--format", default=None, choices=("png", "svg", "pdf"),
+                   help="picture format (default: the suffix of --plot FILE)")
     p.set_defaults(func=cmd_plan)
 
 
@@ -44,8 +47,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
                          f"got {args.time:g}")
     if args.json is not None:
         checks.writable_file(args.json, "plan: --json", make_parent=False)
-    if args.plot is not None:
-        checks.writable_file(args.plot, "plan: --plot", checks.PLOT_SUFFIXES, make_parent=False)
+    plot = picture_path(args.plot, args.format, "plan", "--plot") if args.plot else None
+    if plot is not None:
+        checks.writable_file(plot, "plan: --plot", checks.PLOT_SUFFIXES, make_parent=False)
     scenario = load_scenario(args.scenario)
     r = scenario.robot
     problem = Problem.create(scenario.obstacle_set(), r.start[:2], r.goal, r.radius)
@@ -64,7 +68,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
         from anyplan.viz.planner import save_planner_figure
 
         data = planner.planner_data() if hasattr(planner, "planner_data") else None
-        save_planner_figure(problem, result, args.plot, data)
+        save_planner_figure(problem, result, plot, data)
     lb = result.lower_bound
     ratio = f" ({result.cost / lb:.4f} x lower bound {lb:.3f} m)" if lb and result.solved else ""
     first = ("-" if result.first_solution_time_s is None
@@ -74,3 +78,4 @@ def cmd_plan(args: argparse.Namespace) -> int:
     print(f"  first solution  {first}; solve time {result.solve_time_s:.3f} s")
     print(f"  waypoints       {len(result.path)}")
     return 0 if result.solved else 1
+

@@ -19,7 +19,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``run`` and ``scenarios`` sub-commands."""
     p = sub.add_parser("run", help="simulate a planner on a scenario",
                        description="Simulate a planner on a scenario; writes DIR/result.json "
-                       "and DIR/run.png and prints a summary.")
+                       "and DIR/run.png (or --format svg/pdf) and prints a summary.")
     p.add_argument("scenario", help="built-in scenario name (see 'anyplan scenarios') or YAML file")
     p.add_argument("--planner", default=DEFAULT_PLANNER,
                    help=f"planner name (default {DEFAULT_PLANNER}; one of: {', '.join(AGENTS.names())})")
@@ -30,6 +30,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--time-limit", type=checks.time_limit, default=None,
                    help="simulated time limit [s] (default: the scenario's)")
     p.add_argument("--no-plot", action="store_true", help="do not write run.png")
+    p.add_argument("--format", default="png", choices=("png", "svg", "pdf"),
+                   help="picture format: DIR/run.png, run.svg or run.pdf (default png)")
     p.add_argument("--animate", default=None, metavar="FILE",
                    help="also write an animation of the run (.gif, or .mp4 when ffmpeg is present)")
     p.add_argument("--speed", type=checks.playback_speed, default=4.0,
@@ -81,7 +83,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     if not args.no_plot:
         from anyplan.viz.run import save_run_figure
 
-        save_run_figure(scenario, result, out / "run.png")
+        save_run_figure(scenario, result, out / f"run.{args.format}")
     print(summary(result, out))
     if args.animate:
         from anyplan.viz.animation import animate_run

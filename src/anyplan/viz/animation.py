@@ -24,23 +24,20 @@ from pathlib import Path
 from typing import Any
 
 import matplotlib
+import numpy as np
+from matplotlib import animation
+from matplotlib.patches import Circle as CirclePatch
+from matplotlib.patches import Rectangle
 
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib import animation  # noqa: E402
-from matplotlib.patches import Circle as CirclePatch  # noqa: E402
-from matplotlib.patches import Rectangle  # noqa: E402
-
-from anyplan.world.scenario import Scenario  # noqa: E402
+from anyplan.viz.run import draw_scenario
+from anyplan.viz.style import halo, new_figure, qualitative_colors
+from anyplan.world.scenario import Scenario
 
 __all__ = ["animate_run", "check_target", "frame_times", "ffmpeg_available", "state_at"]
 
 ROBOT_COLOR = "#1f77b4"
 PLAN_COLOR = "#222222"
 VIRTUAL_FACE = "#1e63d6"
-MOVER_COLORS = ["#d62728", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22"]
 
 
 def ffmpeg_available() -> bool:
@@ -123,11 +120,6 @@ def animate_run(scenario: Scenario, result: Any, path: str | Path, *, speed: flo
     Raises:
         ValueError: an unknown suffix, MP4 without ffmpeg, or a non-positive speed/fps.
     """
-    try:
-        from anyplan.viz.run import draw_scenario
-    except ImportError:
-        from anyplan.viz._fallback import draw_scenario
-
     check_target(path, speed)
     path = Path(path)
     suffix = path.suffix.lower()
@@ -136,8 +128,9 @@ def animate_run(scenario: Scenario, result: Any, path: str | Path, *, speed: flo
     t_end = float(traj[-1, 0])
     times, fps_used = frame_times(t_end, speed, fps, max_frames)
 
-    fig, ax = plt.subplots(figsize=(7.5, 7.5 * scenario.height / scenario.width + 0.6))
-    draw_scenario(ax, scenario)
+    fig = new_figure((7.5, 7.5 * scenario.height / scenario.width + 0.6))
+    ax = fig.add_subplot()
+    placer = draw_scenario(ax, scenario)
     r = scenario.robot.radius
 
     # Virtual obstacles: created hidden, shown from their creation time on.
@@ -158,12 +151,13 @@ def animate_run(scenario: Scenario, result: Any, path: str | Path, *, speed: flo
     ax.add_patch(robot)
     (heading,) = ax.plot([], [], "-", color="white", lw=1.8, zorder=9)
     movers = []
+    colors = qualitative_colors(len(scenario.moving_obstacles))
     for k, o in enumerate(scenario.moving_obstacles):
-        c = MOVER_COLORS[k % len(MOVER_COLORS)]
+        c = colors[k]
         patch = CirclePatch((0, 0), o.radius, fc=c, ec="black", alpha=0.85, zorder=7)
         ax.add_patch(patch)
         label = ax.text(0, 0, o.name, fontsize=8, ha="center", va="bottom", color=c, weight="bold",
-                        zorder=9)
+                        zorder=9, path_effects=halo())
         movers.append((o, patch, label))
     clock = ax.text(0.01, 0.99, "", transform=ax.transAxes, ha="left", va="top", fontsize=10,
                     bbox={"fc": "white", "ec": "0.6", "alpha": 0.85}, zorder=10)
@@ -205,6 +199,7 @@ def animate_run(scenario: Scenario, result: Any, path: str | Path, *, speed: flo
     # Blitting: draw the static scene once, then only the moving artists on each frame.
     fig.set_dpi(dpi)
     fig.tight_layout()
+    placer.layout()
     canvas = fig.canvas
     canvas.draw()
     background = canvas.copy_from_bbox(fig.bbox)
@@ -215,7 +210,6 @@ def animate_run(scenario: Scenario, result: Any, path: str | Path, *, speed: flo
         for a in dynamic:
             ax.draw_artist(a)
         frames.append(np.asarray(canvas.buffer_rgba())[:, :, :3].copy())
-    plt.close(fig)
     if suffix == ".gif":
         _write_gif(frames, path, fps_used)
     else:

@@ -14,31 +14,38 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import matplotlib
+import numpy as np
+from matplotlib.colors import to_rgba
+from matplotlib.lines import Line2D
+from matplotlib.patches import Circle as CirclePatch
+from matplotlib.patches import Patch
 
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.colors import to_rgba  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.patches import Circle as CirclePatch  # noqa: E402
-from matplotlib.patches import Patch  # noqa: E402
-
-from anyplan.baselines.dovs.model import arc_points, to_world_frame  # noqa: E402
-from anyplan.baselines.dovs.planner import Decision  # noqa: E402
-from anyplan.baselines.dovs.window import vs_v_max  # noqa: E402
-from anyplan.world.scenario import Scenario  # noqa: E402
+from anyplan.baselines.dovs.model import arc_points, to_world_frame
+from anyplan.baselines.dovs.planner import Decision
+from anyplan.baselines.dovs.window import vs_v_max
+from anyplan.viz.run import draw_scenario
+from anyplan.viz.style import (
+    TEXT_WIDTH_IN,
+    halo,
+    new_figure,
+    paper_style,
+    qualitative_colors,
+    save_figure,
+    tight,
+)
+from anyplan.world.scenario import Scenario
 
 __all__ = ["draw_velocity_space", "draw_decision_world", "save_dovs_figure"]
 
-SOURCE_COLORS = ["#d62728", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22"]
 STATIC_COLOR = "#616161"
 HULL_COLOR = "#bdbdbd"
 
 
-def draw_velocity_space(ax: Any, decision: Decision, *, resolution: int = 241) -> None:
-    """Draw the (omega, v) plane of ``decision`` on ``ax`` (omega horizontal, as in the paper)."""
+def draw_velocity_space(ax: Any, decision: Decision, *, resolution: int = 241, legend: bool = True,
+                        title: bool = True) -> list[Any]:
+    """Draw the (omega, v) plane of ``decision`` on ``ax`` (omega horizontal, as in the paper);
+    returns the legend handles (drawn beside the axes if ``legend``)."""
+    colors = qualitative_colors(len(decision.obstacles) + 1)
     model, cfg = decision.model, decision.model.cfg
     wm, vm = cfg.omega_max, cfg.v_max
     ws = np.linspace(-wm, wm, resolution)
@@ -61,7 +68,7 @@ def draw_velocity_space(ax: Any, decision: Decision, *, resolution: int = 241) -
         m = by_src[:, j] & inside
         if not np.any(m):
             continue
-        color = STATIC_COLOR if name == "static map" else SOURCE_COLORS[j % len(SOURCE_COLORS)]
+        color = STATIC_COLOR if name == "static map" else colors[j % len(colors)]
         rgba = np.array(to_rgba(color, 0.55))
         fresh = m & ~any_src
         both = m & any_src
@@ -115,20 +122,24 @@ def draw_velocity_space(ax: Any, decision: Decision, *, resolution: int = 241) -
     ax.set_xlabel(r"turn rate $\omega$ [rad/s]  (left turn > 0)")
     ax.set_ylabel("linear speed $v$ [m/s]")
     ax.grid(True, lw=0.4, alpha=0.5, zorder=0)
-    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
-              frameon=False, borderaxespad=0.0)
-    ax.set_title(f"DOVS velocity space: chosen (v, $\\omega$) = ({s.v:.3f} m/s, {s.omega:+.3f} rad/s)\n"
-                 f"period T = {cfg.control_period_s:g} s, horizon $T_h$ = {cfg.time_horizon_s:g} s, "
-                 f"merge = {cfg.merge}, {s.n_free} of {s.n_candidates} window samples free", fontsize=10)
+    if legend:
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
+                  frameon=False, borderaxespad=0.0)
+    if title:
+        ax.set_title(f"DOVS velocity space: chosen (v, $\\omega$) = ({s.v:.3f} m/s, {s.omega:+.3f} "
+                     f"rad/s)\nperiod T = {cfg.control_period_s:g} s, horizon $T_h$ = "
+                     f"{cfg.time_horizon_s:g} s, merge = {cfg.merge}, {s.n_free} of {s.n_candidates} "
+                     "window samples free", fontsize=8)
+    return handles
 
 
 def draw_decision_world(ax: Any, scenario: Scenario, decision: Decision,
-                        trajectory: np.ndarray | None = None) -> None:
-    """Draw the arena, the robot, the obstacles' predicted motion and the chosen arc."""
-    from anyplan.viz.run import draw_scenario
-
+                        trajectory: np.ndarray | None = None, *, legend: bool = True) -> Any:
+    """Draw the arena, the robot, the obstacles' predicted motion and the chosen arc; returns
+    the :class:`~anyplan.viz.style.LabelPlacer` of the names (see :func:`draw_scenario`)."""
     cfg = decision.model.cfg
-    draw_scenario(ax, scenario, labels=True)
+    colors = qualitative_colors(len(decision.obstacles) + 1)
+    placer = draw_scenario(ax, scenario, labels=True)
     if trajectory is not None and len(trajectory) > 1:
         ax.plot(trajectory[:, 1], trajectory[:, 2], color="#1f77b4", lw=1.5, zorder=6,
                 label="path so far")
@@ -136,7 +147,7 @@ def draw_decision_world(ax: Any, scenario: Scenario, decision: Decision,
     Th = cfg.time_horizon_s
     ts = np.linspace(0.0, Th, 81)
     for j, ob in enumerate(decision.obstacles):
-        color = SOURCE_COLORS[j % len(SOURCE_COLORS)]
+        color = colors[j % len(colors)]
         if ob.kind == "static":
             x, y, _ = to_world_frame(pose, ob.x, ob.y)
             ax.add_patch(CirclePatch((float(x), float(y)), ob.radius, fc="none", ec=color, ls=":",
@@ -157,8 +168,8 @@ def draw_decision_world(ax: Any, scenario: Scenario, decision: Decision,
                                  zorder=7))
         ax.add_patch(CirclePatch((float(wx[0]), float(wy[0])), ob.radius, fc="none", ec=color,
                                  ls=":", lw=1.0, zorder=7))
-        ax.text(float(wx[0]), float(wy[0]) + ob.radius + 0.1, ob.name, ha="center", va="bottom",
-                fontsize=8, color=color, weight="bold", zorder=8)
+        placer.add((float(wx[0]), float(wy[0])), ob.name, gap_pt=5.0, fontsize=8, color=color,
+                   weight="bold", zorder=8, path_effects=halo())
     s = decision.selection
     if s.v > 1e-9:
         ss = np.linspace(0.0, s.v * Th, 81)
@@ -170,22 +181,33 @@ def draw_decision_world(ax: Any, scenario: Scenario, decision: Decision,
     ax.annotate("", xy=(pose[0] + 0.7 * math.cos(pose[2]), pose[1] + 0.7 * math.sin(pose[2])),
                 xytext=pose[:2], arrowprops={"arrowstyle": "->", "color": "black", "lw": 1.5},
                 zorder=10)
-    ax.legend(loc="lower left", fontsize=8, framealpha=0.9)
+    if legend:
+        ax.legend(loc="lower left", fontsize=8, framealpha=0.9)
+    placer.layout()
+    return placer
 
 
 def save_dovs_figure(scenario: Scenario, decision: Decision, t: float, path: str | Path, *,
                      trajectory: np.ndarray | Sequence[Sequence[float]] | None = None,
-                     note: str = "", dpi: int = 130) -> Path:
-    """Write the two-panel picture of ``decision`` (taken at time ``t`` [s]) to ``path`` (PNG)."""
-    path = Path(path)
+                     note: str = "", dpi: int = 300) -> Path:
+    """Write the two-panel picture of ``decision`` (taken at time ``t`` [s]) to ``path`` (PNG,
+    SVG or PDF by the suffix), 7.16 in wide with the legends below the panels."""
     traj = None if trajectory is None else np.asarray(trajectory, dtype=float).reshape(-1, 6)
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(16.5, 6.2), gridspec_kw={"width_ratios": [1.25, 1.0]})
-    draw_decision_world(a1, scenario, decision, traj)
+    cfg, s = decision.model.cfg, decision.selection
     v0, w0 = decision.velocity
-    a1.set_title(f"{scenario.name} at t = {t:.2f} s: robot v = {v0:.3f} m/s, "
-                 f"$\\omega$ = {w0:+.3f} rad/s" + (f"\n{note}" if note else ""), fontsize=10)
-    draw_velocity_space(a2, decision)
-    fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
-    return path
+    with paper_style():
+        fig = new_figure((TEXT_WIDTH_IN, 5.4))
+        a1, a2 = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.3, 1.0]})
+        placer = draw_decision_world(a1, scenario, decision, traj, legend=False)
+        a1.set_title(f"{scenario.name} at t = {t:.2f} s:\nrobot v = {v0:.3f} m/s, "
+                     f"$\\omega$ = {w0:+.3f} rad/s" + (f"\n{note}" if note else ""))
+        handles = draw_velocity_space(a2, decision, legend=False, title=False)
+        a2.set_title(f"velocity space: chosen v = {s.v:.3f} m/s,\n$\\omega$ = {s.omega:+.3f} rad/s "
+                     f"({s.n_free} of {s.n_candidates} samples free)")
+        world = a1.get_legend_handles_labels()
+        fig.legend(world[0] + handles, world[1] + [h.get_label() for h in handles],
+                   loc="lower center", ncol=2, frameon=False)
+        fig.suptitle(f"DOVS decision: period T = {cfg.control_period_s:g} s, horizon $T_h$ = "
+                     f"{cfg.time_horizon_s:g} s, merge = {cfg.merge}")
+        tight(fig, (0.0, 0.3, 1.0, 1.0))
+    return save_figure(fig, path, placers=[placer], dpi=dpi)

@@ -6,21 +6,18 @@ import math
 from pathlib import Path
 from typing import Any
 
-import matplotlib
+import numpy as np
+from matplotlib.collections import LineCollection
+from matplotlib.lines import Line2D
+from matplotlib.patches import Circle as CirclePatch
+from matplotlib.patches import Ellipse, Rectangle
+from matplotlib.patches import Polygon as PolygonPatch
 
-matplotlib.use("Agg", force=False)
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.collections import LineCollection  # noqa: E402
-from matplotlib.patches import Circle as CirclePatch  # noqa: E402
-from matplotlib.patches import Ellipse, Rectangle  # noqa: E402
-from matplotlib.patches import Polygon as PolygonPatch  # noqa: E402
-
-from anyplan.geometry.shapes import Circle  # noqa: E402
-from anyplan.planning.base import PlanResult  # noqa: E402
-from anyplan.planning.bitstar import PlannerData  # noqa: E402
-from anyplan.planning.problem import Problem  # noqa: E402
+from anyplan.geometry.shapes import Circle
+from anyplan.planning.base import PlanResult
+from anyplan.planning.bitstar import PlannerData
+from anyplan.planning.problem import Problem
+from anyplan.viz.style import COLUMN_WIDTH_IN, halo, new_figure, paper_style, save_figure, tight
 
 __all__ = ["draw_planner", "save_planner_figure"]
 
@@ -36,7 +33,7 @@ def _draw_obstacles(ax: Any, problem: Problem) -> None:
 
 
 def draw_planner(ax: Any, problem: Problem, result: PlanResult,
-                 data: PlannerData | None = None) -> None:
+                 data: PlannerData | None = None, *, legend: bool = True) -> None:
     """Draw a planning query on ``ax``.
 
     Args:
@@ -44,12 +41,15 @@ def draw_planner(ax: Any, problem: Problem, result: PlanResult,
         problem: The problem (obstacles, walls, start, goal, robot radius).
         result: The planner's result (its path is drawn in red).
         data: BIT*'s planner data (samples, tree, informed ellipse), if any.
+        legend: Add a legend inside the axes.
     """
     _draw_obstacles(ax, problem)
+    ax.plot([], [], "s", color="0.35", label="obstacle")
     if data is not None:
         if len(data.edges):
             ax.add_collection(LineCollection(data.edges, colors="tab:blue", linewidths=0.4,
-                                             alpha=0.6, zorder=3, label="tree"))
+                                             alpha=0.6, zorder=3))
+            ax.add_line(Line2D([], [], color="tab:blue", lw=0.8, label="tree"))
         if len(data.samples):
             ax.plot(data.samples[:, 0], data.samples[:, 1], ".", ms=1.5, color="tab:gray",
                     zorder=3, label="samples")
@@ -69,30 +69,33 @@ def draw_planner(ax: Any, problem: Problem, result: PlanResult,
                 label=f"path {result.cost:.3f} m")
     for p, c, lab in ((problem.start, "tab:green", "start"), (problem.goal, "tab:orange", "goal")):
         ax.add_patch(CirclePatch(tuple(p), max(problem.radius, 0.05), color=c, zorder=6))
-        ax.annotate(lab, tuple(p), xytext=(4, 4), textcoords="offset points", fontsize=8)
+        ax.annotate(lab, tuple(p), xytext=(5, 5), textcoords="offset points", fontsize=8,
+                    path_effects=halo(), zorder=7)
     xmin, ymin, xmax, ymax = problem.bounds
     ax.set_xlim(xmin - 0.2, xmax + 0.2)
     ax.set_ylim(ymin - 0.2, ymax + 0.2)
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    lb = "" if result.lower_bound is None else f", lower bound {result.lower_bound:.3f} m"
+    lb = "" if result.lower_bound is None else f"\nlower bound {result.lower_bound:.3f} m"
     first = ("" if result.first_solution_time_s is None
              else f", first solution {1e3 * result.first_solution_time_s:.1f} ms")
-    ax.set_title(f"{result.planner}: {result.status.value}{first}{lb}", fontsize=9)
-    ax.legend(loc="upper left", fontsize=7, framealpha=0.8)
+    ax.set_title(f"{result.planner}: {result.status.value}{first}{lb}", fontsize=8)
+    if legend:
+        ax.legend(loc="upper left", framealpha=0.8)
 
 
 def save_planner_figure(problem: Problem, result: PlanResult, path: str | Path,
                         data: PlannerData | None = None) -> None:
-    """Write :func:`draw_planner`'s picture to ``path`` (PNG, PDF or SVG by extension)."""
+    """Write :func:`draw_planner`'s picture to ``path`` (PNG, PDF or SVG by extension), one
+    column (3.5 in) wide, the legend below the plot."""
     xmin, ymin, xmax, ymax = problem.bounds
-    w = 9.0
-    h = max(3.0, w * (ymax - ymin) / max(xmax - xmin, 1e-9))
-    fig, ax = plt.subplots(figsize=(w, h + 0.6))
-    try:
-        draw_planner(ax, problem, result, data)
-        fig.tight_layout()
-        fig.savefig(path, dpi=130)
-    finally:
-        plt.close(fig)
+    w = COLUMN_WIDTH_IN
+    h = 0.85 * w * (ymax - ymin) / max(xmax - xmin, 1e-9)
+    with paper_style():
+        fig = new_figure((w, h + 1.6))
+        ax = fig.add_subplot()
+        draw_planner(ax, problem, result, data, legend=False)
+        fig.legend(*ax.get_legend_handles_labels(), loc="lower center", ncol=2, frameon=False)
+        tight(fig, (0.0, 0.16, 1.0, 1.0))
+    save_figure(fig, path)

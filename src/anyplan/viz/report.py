@@ -1,67 +1,68 @@
-"""Figures and a self-contained HTML report from a results database (and nothing else).
+"""Figures and a self-contained, interactive HTML report from a results database (and nothing else).
+
+Figures are made at print size (7.16 in wide, fonts of 8 pt and more; :mod:`anyplan.viz.style`)
+and written as PNG, SVG or PDF (``fmt``):
 
 * ``figure4.png``: the paper's Figure 4 as a grid, rows = planners, columns = scenarios
   (paper-1..3 when present): each panel is one representative run (the first successful run,
   else the first run) with its executed path, the obstacles and the virtual obstacles, drawn by
-  :func:`anyplan.viz.run.draw_run`.
+  :func:`anyplan.viz.run.draw_run`; one time colour bar [s] shared by the panels, one legend.
 * ``boxplots.png``: path length, path generation time, time to goal and minimum clearance per
   planner and number of moving obstacles.
 * ``cost_time.png``: best cost against planning time from the ``progress`` table, for anytime
   planners that report it (``source = 'planner'``) and OMPL planners imported into the database
   (``source`` NULL, e.g. ``geometric_BITstar``, dashed): median over runs with the inter-quartile
-  band. Without such rows, the lengths of the executed plans against simulated time.
-* ``tables.md``, ``tables.csv`` and ``report.html`` (images embedded as base64).
+  band, thin lines for single runs; one panel per scenario (all scenarios, small multiples).
+  Without such rows, the lengths of the executed plans against simulated time.
+* ``tables.md``, ``tables.csv`` and ``report.html`` (:mod:`anyplan.viz.report_html`: navigation,
+  sortable tables, plots, drill-down to the runs and their playback; figures embedded as PNG).
 """
 
 from __future__ import annotations
 
-import base64
-import html
+import io
 import json
 import math
+import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import matplotlib
+import numpy as np
+from matplotlib.colors import Normalize
+from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter
 
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from anyplan.experiments.db import ResultsDB  # noqa: E402
-from anyplan.experiments.tables import (  # noqa: E402
-    HEADERS,
-    PAPER_TABLES,
-    PlannerTable,
-    _cells,
-    paper_runs,
-    summarize,
-    write_tables,
+from anyplan.experiments.db import ResultsDB
+from anyplan.experiments.tables import paper_runs, summarize, write_tables
+from anyplan.viz.run import PATH_CMAP, draw_run, run_legend_handles
+from anyplan.viz.style import (
+    COLUMN_WIDTH_IN,
+    TEXT_WIDTH_IN,
+    LabelPlacer,
+    figure_path,
+    new_figure,
+    paper_style,
+    save_figure,
+    tight,
 )
-from anyplan.world.scenario import Scenario, scenario_from_dict  # noqa: E402
+from anyplan.world.scenario import Scenario, scenario_from_dict
 
 __all__ = ["build_report", "figure4", "boxplots", "cost_time_figure", "draw_run_panel"]
 
 PLANNER_COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf"]
 
 
-def draw_run_panel(ax: Any, scenario: Scenario, result: dict[str, Any]) -> None:
-    """One run on ``ax``: :func:`anyplan.viz.run.draw_run` without colour bar and title (a minimal
-    drawing if that module is unavailable)."""
-    try:
-        from anyplan.viz.run import draw_run
-    except ImportError:
-        from anyplan.viz._fallback import draw_run
-
-    draw_run(ax, scenario, result, colorbar=False, title=False)
-    # Obstacles may leave the arena: keep the panel on the arena and clip labels outside it.
+def draw_run_panel(ax: Any, scenario: Scenario, result: dict[str, Any], *, t_max: float | None = None
+                   ) -> LabelPlacer:
+    """One run on ``ax``: :func:`anyplan.viz.run.draw_run` without colour bar and title, on the
+    arena (obstacles may leave it; what lies outside is clipped). Returns its label placer."""
     x0, y0, x1, y1 = scenario.bounds
     ax.set_xlim(x0 - 0.3, x1 + 0.3)
     ax.set_ylim(y0 - 0.3, y1 + 0.3)
-    for artist in [*ax.texts, *ax.patches, *ax.lines, *ax.collections]:
+    placer = draw_run(ax, scenario, result, colorbar=False, title=False, t_max=t_max)
+    for artist in [*ax.patches, *ax.lines, *ax.collections]:
         artist.set_clip_on(True)
+    return placer
 
 
 def _scenarios(db: ResultsDB) -> dict[int, Scenario]:
@@ -83,8 +84,9 @@ def _planner_order(runs: Sequence[dict[str, Any]]) -> list[str]:
     return sorted({r["planner"] for r in runs}, key=lambda n: (order.get(n, 9), n))
 
 
-def figure4(db: ResultsDB, path: str | Path, max_columns: int = 3) -> Path | None:
-    """The Figure 4 grid (see the module docstring); None if the database has no runs."""
+def figure4(db: ResultsDB, path: str | Path, max_columns: int = 3, png_copy: Any = None) -> Path | None:
+    """The Figure 4 grid (see the module docstring), 7.16 in wide, one time colour bar [s]
+    shared by all panels and one legend; None if the database has no runs."""
     runs = _our_runs(db)
     scen = _scenarios(db)
     runs = [r for r in runs if r["experimentid"] in scen]
@@ -96,62 +98,74 @@ def figure4(db: ResultsDB, path: str | Path, max_columns: int = 3) -> Path | Non
         exps.setdefault(r["scenario"], r["experimentid"])
     names = [n for n in ("paper-1", "paper-2", "paper-3") if n in exps] or list(exps)
     names = names[:max_columns]
-    nr, nc = len(planners), len(names)
-    sc0 = scen[exps[names[0]]]
-    aspect = sc0.height / sc0.width
-    fig, axes = plt.subplots(nr, nc, figsize=(5.2 * nc, 5.2 * nc * aspect / nc * nr + 0.6 * nr + 0.4),
-                             squeeze=False)
+    panels: dict[tuple[int, int], tuple[dict[str, Any], dict[str, Any], list[dict[str, Any]]]] = {}
     for i, planner in enumerate(planners):
         for j, name in enumerate(names):
-            ax = axes[i][j]
             cand = [r for r in runs if r["planner"] == planner and r["scenario"] == name]
-            if not cand:
-                ax.set_axis_off()
-                ax.set_title(f"{planner} / {name}: no run", fontsize=9)
-                continue
             cand.sort(key=lambda r: (r["outcome"] != "reached", r["run_index"] or 0, r["id"]))
-            best = cand[0]
-            res = db.result(int(best["id"]))
-            sc = scen[best["experimentid"]]
-            if res is None:
+            res = db.result(int(cand[0]["id"])) if cand else None
+            if res is not None:
+                panels[(i, j)] = (cand[0], res, cand)
+    t_max = max((float(res["trajectory"][-1][0]) for _, res, _ in panels.values() if res["trajectory"]),
+                default=1.0)
+    nr, nc = len(planners), len(names)
+    sc0 = scen[exps[names[0]]]
+    panel_w = (0.88 * TEXT_WIDTH_IN - 0.7) / nc
+    panel_h = panel_w * (sc0.height + 0.6) / (sc0.width + 0.6) + 0.55
+    with paper_style():
+        fig_h = nr * panel_h + 1.2
+        fig = new_figure((TEXT_WIDTH_IN, fig_h))
+        axes = fig.subplots(nr, nc, squeeze=False)
+        placers = []
+        for (i, j), ax in np.ndenumerate(axes):
+            planner, name = planners[i], names[j]
+            if (i, j) not in panels:
                 ax.set_axis_off()
+                ax.set_title(f"{name}: no run")
                 continue
-            draw_run_panel(ax, sc, res)
+            best, res, cand = panels[(i, j)]
+            placers.append(draw_run_panel(ax, scen[best["experimentid"]], res, t_max=t_max))
             ok = sum(r["outcome"] == "reached" for r in cand)
             outcome = res.get("status", "?")
             if outcome == "collision":
-                outcome = f"collided with {res.get('collision_with')}"
-            ax.set_title(f"{planner} on {name} (run {best['run_index']}): {outcome}\n"
-                         f"L = {res.get('path_length_m', float('nan')):.2f} m, "
-                         f"{len(res.get('virtual_obstacles') or [])} virtual obstacles; "
-                         f"{ok}/{len(cand)} runs reached the goal", fontsize=8.5)
-            if j > 0:
-                ax.set_ylabel("")
+                outcome = f"hit {res.get('collision_with')}"
+            ax.set_title(f"{name}, run {best['run_index']}: {outcome}\n"
+                         f"L = {res.get('path_length_m', float('nan')):.2f} m, {ok}/{len(cand)} reached")
+            ax.set_ylabel(f"{planner}\ny [m]" if j == 0 else "")
             if i < nr - 1:
                 ax.set_xlabel("")
-    fig.suptitle("Executed paths per planner (rows) and scenario (columns), as the paper's Figure 4",
-                 fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, 0.97))
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+        import matplotlib
+
+        sm = matplotlib.cm.ScalarMappable(norm=Normalize(0.0, t_max), cmap=PATH_CMAP)
+        tight(fig, (0.0, 0.65 / fig_h, 0.9, 1.0), h_pad=0.6, w_pad=0.4)
+        cax = fig.add_axes((0.91, 0.25, 0.018, 0.6))
+        fig.colorbar(sm, cax=cax).set_label("time [s]")
+        fig.legend(handles=run_legend_handles(), loc="lower center", ncol=3, frameon=False)
+        for p in placers:
+            p.layout()
+    return save_figure(fig, path, placers=placers, png_copy=png_copy)
 
 
-BOX_METRICS = [("path_length", "path length [m] (successful runs)", True),
-               ("planning_time_mean", "path generation time [s] (mean per run)", False),
-               ("time_to_goal", "time to goal [s] (successful runs)", True),
-               ("min_clearance", "minimum clearance [m]", False)]
+BOX_METRICS = [("path_length", "path length [m]\n(successful runs)", True),
+               ("planning_time_mean", "generation time [s]\n(mean per run)", False),
+               ("time_to_goal", "time to goal [s]\n(successful runs)", True),
+               ("min_clearance", "min. clearance [m]\n(all runs)", False)]
 
 
-def boxplots(db: ResultsDB, path: str | Path) -> Path | None:
+def boxplots(db: ResultsDB, path: str | Path, png_copy: Any = None) -> Path | None:
     """Box plots of the metrics per planner, grouped by the number of moving obstacles."""
     runs = _our_runs(db)
     if not runs:
         return None
     planners = _planner_order(runs)
+    with paper_style():
+        return _boxplots(runs, planners, path, png_copy)
+
+
+def _boxplots(runs: list[dict[str, Any]], planners: list[str], path: str | Path, png_copy: Any) -> Path:
     ns = sorted({int(r["n_moving"]) for r in runs if r["n_moving"] is not None})
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5))
+    fig = new_figure((TEXT_WIDTH_IN, 5.6))
+    axes = fig.subplots(2, 2)
     width = 0.8 / max(len(planners), 1)
     for ax, (col, label, only_ok) in zip(axes.ravel(), BOX_METRICS, strict=True):
         drawn = False
@@ -173,7 +187,7 @@ def boxplots(db: ResultsDB, path: str | Path) -> Path | None:
                 # Every run as a dot (boxes of identical values collapse to a line).
                 jitter = np.random.default_rng(k).uniform(-0.25, 0.25, size=sum(len(d) for d in data))
                 xs = np.concatenate([np.full(len(d), x) for d, x in zip(data, pos, strict=True)])
-                ax.scatter(xs + jitter * width, np.concatenate(data), s=9, color=color, alpha=0.7,
+                ax.scatter(xs + jitter * width, np.concatenate(data), s=5, color=color, alpha=0.7,
                            zorder=3, lw=0)
                 drawn = True
             ax.plot([], [], "s", color=PLANNER_COLORS[k % len(PLANNER_COLORS)], alpha=0.6, label=planner)
@@ -185,13 +199,14 @@ def boxplots(db: ResultsDB, path: str | Path) -> Path | None:
         ax.grid(axis="y", alpha=0.3)
         if not drawn:
             ax.text(0.5, 0.5, "no data", transform=ax.transAxes, ha="center", va="center", color="gray")
-    axes[0][0].legend(fontsize=8)
-    fig.suptitle("Metrics per planner and number of moving obstacles", fontsize=11)
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+        ax.yaxis.set_major_locator(MaxNLocator(nbins=5))
+    fig.legend(*axes[0][0].get_legend_handles_labels(), loc="lower center", frameon=False,
+               ncol=min(len(planners), 4))
+    fig.suptitle("Metrics per planner and number of moving obstacles\n(boxes: quartiles and median; "
+                 "dots: single runs)")
+    rows = math.ceil(len(planners) / 4)
+    tight(fig, (0.0, (0.1 + 0.17 * rows) / 5.6, 1.0, 1.0))
+    return save_figure(fig, path, png_copy=png_copy)
 
 
 def _step_median(curves: list[tuple[np.ndarray, np.ndarray]], grid: np.ndarray
@@ -210,10 +225,12 @@ def _step_median(curves: list[tuple[np.ndarray, np.ndarray]], grid: np.ndarray
     return med, np.where(np.isfinite(lo), lo, np.nan), np.where(np.isfinite(hi), hi, np.nan)
 
 
-def cost_time_figure(db: ResultsDB, path: str | Path) -> Path | None:
-    """Cost against time (see the module docstring); None if there is no progress data."""
+def cost_time_figure(db: ResultsDB, path: str | Path, max_columns: int = 3,
+                     png_copy: Any = None) -> Path | None:
+    """Cost against time (see the module docstring), one panel per scenario (all of them, as
+    small multiples ``max_columns`` wide); None if there is no progress data."""
     rows = db.query("SELECT p.runid, p.time, p.best_cost, p.source, c.name AS planner, r.experimentid, "
-                    "e.name AS scenario FROM progress p JOIN runs r ON r.id = p.runid "
+                    "r.sim_time, e.name AS scenario FROM progress p JOIN runs r ON r.id = p.runid "
                     "JOIN plannerConfigs c ON c.id = r.plannerid JOIN experiments e ON e.id = r.experimentid "
                     "WHERE p.best_cost IS NOT NULL ORDER BY p.runid, p.time")
     anytime = [r for r in rows if r["source"] in (None, "planner")]
@@ -221,86 +238,109 @@ def cost_time_figure(db: ResultsDB, path: str | Path) -> Path | None:
     if not use:
         return None
     by: dict[tuple[str, str], dict[int, list[tuple[float, float]]]] = {}
+    ends: dict[int, float] = {}
     for r in use:
         by.setdefault((r["scenario"], r["planner"]), {}).setdefault(r["runid"], []).append(
             (float(r["time"]), float(r["best_cost"])))
-    scenarios = sorted({k[0] for k in by})[:4]
-    fig, axes = plt.subplots(1, len(scenarios), figsize=(5.4 * len(scenarios), 4.2), squeeze=False)
+        if r["sim_time"] is not None:
+            ends[r["runid"]] = float(r["sim_time"])
+    scenarios = sorted({k[0] for k in by})
     planners = sorted({k[1] for k in by})
-    for ax, scn in zip(axes[0], scenarios, strict=False):
-        for k, planner in enumerate(planners):
-            runs = by.get((scn, planner))
-            if not runs:
-                continue
-            color = PLANNER_COLORS[k % len(PLANNER_COLORS)]
-            ompl = planner.startswith("geometric_") or planner.startswith("control_")
-            curves = [(np.array([p[0] for p in v]), np.array([p[1] for p in v])) for v in runs.values()]
-            if anytime:
-                # Anytime costs only improve: keep the running minimum.
-                curves = [(t, np.minimum.accumulate(c)) for t, c in curves]
-            tmax = max(float(t[-1]) for t, _ in curves)
-            tmin = min(float(t[0]) for t, _ in curves)
-            for t, c in curves[:30]:
-                ax.step(t, c, where="post", color=color, alpha=0.25 if anytime else 0.5, lw=0.8,
-                        marker="" if anytime and len(t) > 20 else "o", ms=3)
-            if anytime and tmax > tmin:
-                grid = np.geomspace(tmin, tmax, 200) if tmin > 0.0 else np.linspace(tmin, tmax, 200)
-                med, lo, hi = _step_median(curves, grid)
-                ax.plot(grid, med, color=color, lw=2, ls="--" if ompl else "-",
-                        label=f"{planner} (median of {len(curves)})")
-                ax.fill_between(grid, lo, hi, color=color, alpha=0.15, lw=0)
-            else:
-                ax.plot([], [], color=color, lw=2, label=f"{planner} ({len(curves)} runs)")
-        ax.set_title(scn, fontsize=10)
-        if not anytime:  # a single plan at t = 0 would give a degenerate axis
-            t_hi = max((t for (s_, _), runs in by.items() if s_ == scn for v in runs.values() for t, _ in v),
-                       default=0.0)
-            ax.set_xlim(-0.02 * max(t_hi, 1.0), 1.05 * max(t_hi, 1.0))
-        times = [t for (s_, _), runs in by.items() if s_ == scn for v in runs.values() for t, _ in v]
-        if anytime and times and min(times) > 0.0:  # anytime curves change most early on
-            ax.set_xscale("log")
-        ax.set_xlabel("planning time [s]" if anytime else "simulated time [s]")
-        ax.set_ylabel("best cost [m]" if anytime else "plan length [m]")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.suptitle("Best cost against planning time (OMPL planners dashed)" if anytime else
-                 "Length of each new plan over the run (no anytime progress recorded)", fontsize=11)
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    ompl_any = any(p.startswith(("geometric_", "control_")) for p in planners)
+    nc = min(max_columns, len(scenarios))
+    nr = math.ceil(len(scenarios) / nc)
+    with paper_style():
+        fig_w = TEXT_WIDTH_IN if nc > 1 else COLUMN_WIDTH_IN
+        fig_h = 2.1 * nr + 1.1
+        fig = new_figure((fig_w, fig_h))
+        axes = fig.subplots(nr, nc, squeeze=False)
+        for ax in axes.ravel()[len(scenarios):]:
+            ax.set_axis_off()
+        handles: dict[str, Any] = {}
+        for ax, scn in zip(axes.ravel(), scenarios, strict=False):
+            _cost_panel(ax, scn, by, planners, anytime=bool(anytime), ends=ends, handles=handles)
+        if anytime:
+            title = ("Best solution cost against planning time: median over runs (thick line), "
+                     "inter-quartile range (band),\nsingle runs (thin lines)"
+                     + ("; OMPL planners dashed" if ompl_any else ""))
+        else:
+            title = ("No anytime progress recorded: length of each new plan against the simulated "
+                     "time it was made,\none line per run")
+        fig.suptitle(textwrap.fill(title.replace("\n", " "), width=int(12 * fig_w), break_on_hyphens=False))
+        fig.legend(handles=list(handles.values()), loc="lower center", frameon=False,
+                   ncol=1 if nc == 1 else min(len(handles), 3))
+        legend_rows = len(handles) if nc == 1 else math.ceil(len(handles) / 3)
+        tight(fig, (0.0, (0.12 + 0.16 * legend_rows) / fig_h, 1.0, 1.0))
+    return save_figure(fig, path, png_copy=png_copy)
 
 
-def _html_table(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
-    head = "".join(f"<th>{html.escape(h)}</th>" for h in headers)
-    body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in rows)
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
-
-
-def _paper_html(tables: Sequence[PlannerTable]) -> str:
-    parts = []
-    for t in tables:
-        paper = PAPER_TABLES.get(t.planner)
-        if not paper:
+def _cost_panel(ax: Any, scn: str, by: dict[tuple[str, str], dict[int, list[tuple[float, float]]]],
+                planners: list[str], *, anytime: bool, ends: dict[int, float],
+                handles: dict[str, Any]) -> None:
+    times: list[float] = []
+    t_all = [p[0] for pl in planners for v in (by.get((scn, pl)) or {}).values() for p in v]
+    # Planning times in the unit that gives readable ticks (no "1e-5" offset).
+    unit, scale = ("s", 1.0)
+    if anytime and t_all and max(t_all) < 1.0:
+        unit, scale = ("ms", 1e3) if max(t_all) >= 1e-3 else ("µs", 1e6)
+    for k, planner in enumerate(planners):
+        runs = by.get((scn, planner))
+        if not runs:
             continue
-        mine = {r.n_moving: r for r in t.rows}
-        rows = []
-        for n in sorted(set(mine) | set(paper["rows"])):
-            p = paper["rows"].get(n, "n/a")
-            pc = ["crashed"] * 3 if p is None else ["-"] * 3 if p == "n/a" else [f"{x:g}" for x in p]
-            r = mine.get(n)
-            oc = ([r.path_length.fmt(3), r.generation_time.fmt(4), r.time_to_goal.fmt(2),
-                   f"{r.successes}/{r.runs}"] if r else ["-"] * 4)
-            rows.append([str(n), oc[0], pc[0], oc[1], pc[1], oc[2], pc[2], oc[3]])
-        parts.append(f"<h3>{html.escape(t.title)} against {html.escape(paper['title'])}</h3>" + _html_table(
-            ["moving obstacles", "path length [m] ours", "paper", "generation time [s] ours", "paper",
-             "time to goal [s] ours", "paper", "successes ours"], rows))
-    return "".join(parts)
+        color = PLANNER_COLORS[k % len(PLANNER_COLORS)]
+        ls = "--" if planner.startswith(("geometric_", "control_")) else "-"
+        curves = []
+        for runid, v in runs.items():
+            t = scale * np.array([p[0] for p in v])
+            c = np.array([p[1] for p in v])
+            if anytime:  # anytime costs only improve: keep the running minimum
+                c = np.minimum.accumulate(c)
+            elif runid in ends and ends[runid] > t[-1]:  # the last plan holds to the run's end
+                t, c = np.append(t, ends[runid]), np.append(c, c[-1])
+            curves.append((t, c))
+            times.extend(t.tolist())
+        for t, c in curves:
+            if len(t) == 1:  # one solution and no later improvement: a point
+                ax.plot(t, c, marker="o", ms=3, color=color, alpha=0.6, ls="none")
+            ax.step(t, c, where="post", color=color, alpha=0.3 if anytime else 0.6, lw=0.6, ls=ls)
+        tmin = min(float(t[0]) for t, _ in curves)
+        tmax = max(float(t[-1]) for t, _ in curves)
+        label = f"{planner} ({len(curves)} runs)"
+        if anytime and tmax > tmin:
+            grid = np.geomspace(tmin, tmax, 200) if tmin > 0.0 else np.linspace(tmin, tmax, 200)
+            med, lo, hi = _step_median(curves, grid)
+            (line,) = ax.plot(grid, med, color=color, lw=1.6, ls=ls)
+            ax.fill_between(grid, lo, hi, color=color, alpha=0.15, lw=0)
+            label = f"{planner} (median of {len(curves)} runs)"
+        else:
+            (line,) = ax.plot([], [], color=color, lw=1.6, ls=ls)
+        line.set_label(label)
+        handles.setdefault(label, line)
+    ax.set_title(scn)
+    if anytime and times and min(times) > 0.0 and max(times) > 10.0 * min(times):
+        # Anytime curves change most early on: a log axis once they span a decade.
+        ax.set_xscale("log")
+        ax.xaxis.set_major_locator(LogLocator(numticks=4))
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    else:
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=4))
+        if not anytime:  # a single plan at t = 0 would give a degenerate axis
+            t_hi = max(times, default=1.0)
+            ax.set_xlim(-0.02 * max(t_hi, 1.0), 1.05 * max(t_hi, 1.0))
+    ax.yaxis.set_major_locator(MaxNLocator(nbins=5))
+    ax.set_xlabel(f"planning time [{unit}]" if anytime else "simulated time [s]")
+    ax.set_ylabel("best cost [m]" if anytime else "plan length [m]")
+    ax.grid(alpha=0.3)
 
 
-def build_report(db_path: str | Path, out: str | Path) -> list[Path]:
-    """Write the figures, tables and ``report.html`` of ``db_path`` into ``out``."""
+def build_report(db_path: str | Path, out: str | Path, fmt: str = "png") -> list[Path]:
+    """Write the figures (in ``fmt``: png, svg or pdf), the tables and the interactive
+    ``report.html`` of ``db_path`` into ``out``; returns the files written."""
+    from anyplan.viz.report_data import report_data
+    from anyplan.viz.report_html import render_page
+
+    fmt = figure_path("x", fmt).suffix[1:]
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     with ResultsDB(db_path, readonly=True) as db:
@@ -308,40 +348,15 @@ def build_report(db_path: str | Path, out: str | Path) -> list[Path]:
         tables = summarize(runs)
         ptables = summarize(paper_runs(runs))
         written = write_tables(tables, out, ptables)
-        figs = [("Figure 4: executed paths", figure4(db, out / "figure4.png")),
-                ("Metrics", boxplots(db, out / "boxplots.png")),
-                ("Cost against time", cost_time_figure(db, out / "cost_time.png"))]
-        exps = db.experiments()
-    written += [p for _, p in figs if p is not None]
-    n_ours = sum(r.get("outcome") is not None for r in runs)
-    parts = ["<!doctype html><html><head><meta charset='utf-8'><title>anyplan benchmark report</title>",
-             "<style>body{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 1em}"
-             "table{border-collapse:collapse;margin:0.5em 0 1.5em}td,th{border:1px solid #bbb;"
-             "padding:3px 8px;text-align:right}th{background:#eee}img{max-width:100%}"
-             "code{background:#f4f4f4}</style></head><body>",
-             "<h1>anyplan benchmark report</h1>",
-             f"<p>Database <code>{html.escape(str(db_path))}</code>: {len(exps)} experiments "
-             f"(scenarios), {n_ours} anyplan runs"
-             + (f", {len(runs) - n_ours} imported runs" if len(runs) > n_ours else "") + ". "
-             "Path length and time to goal are over the successful runs; path generation time is "
-             "each run's mean planning-call time. Crashes are collisions with an obstacle; errors are "
-             "planner exceptions.</p>",
-             "<h2>Tables</h2>"]
-    for t in tables:
-        parts.append(f"<h3>{html.escape(t.title)}</h3>" + _html_table(HEADERS, [_cells(r) for r in t.rows]))
-    parts.append(_paper_html(ptables))
-    parts.append("<h2>Scenarios</h2>" + _html_table(
-        ["experiment", "scenario", "moving obstacles", "hash", "master seed", "runs", "version"],
-        [[str(e["id"]), str(e["name"]), str(e.get("moving_obstacles", "")), str(e.get("scenario_hash", "")),
-          str(e["seed"]), str(e["runcount"]), str(e["version"])] for e in exps]))
-    for title, p in figs:
-        if p is None:
-            continue
-        b64 = base64.b64encode(p.read_bytes()).decode()
-        parts.append(f"<h2>{html.escape(title)}</h2><img alt='{html.escape(title)}' "
-                     f"src='data:image/png;base64,{b64}'>")
-    parts.append("</body></html>")
-    page = out / "report.html"
-    page.write_text("\n".join(parts))
-    written.append(page)
+        pngs: list[tuple[str, bytes]] = []
+        for title, fn, name in (("Figure 4: executed paths", figure4, "figure4"),
+                                ("Metrics", boxplots, "boxplots"),
+                                ("Cost against time", cost_time_figure, "cost_time")):
+            buf = io.BytesIO()
+            p = fn(db, out / f"{name}.{fmt}", png_copy=buf)
+            if p is not None:
+                written.append(p)
+                pngs.append((title, buf.getvalue()))
+        data = report_data(db, _scenarios(db), db_name=Path(db_path).name)
+    written.append(render_page(data, ptables, pngs, out / "report.html"))
     return written
