@@ -211,3 +211,19 @@ def test_format_conflicting_with_the_suffix_is_one_line(tmp_path, capsys):
     assert main(["plan", "paper-1", "--plot", str(tmp_path / "p.png"), "--format", "svg"]) == 2
     err = capsys.readouterr().err
     assert "--format says svg" in err and err.count("\n") == 1
+
+
+def test_recorded_tracks_are_drawn_only_while_they_exist(tmp_path, saved):
+    data = dict(FEW, dynamic_obstacles=[{"name": "P1", "type": "track", "radius": 0.2,
+                                         "samples": [[2.0, 1.0, 2.5], [4.0, 3.0, 2.5]]}])
+    sc = scenario_from_dict(data)
+    res = simulate(sc, make_agent("straight"), seed=0).to_dict()
+    viz_run.save_run_figure(sc, res, tmp_path / "run.png")
+    fig, problems = saved["run.png"]
+    assert problems == []
+    (track,) = [ln for ln in fig.axes[0].get_lines() if ln.get_linestyle() == "--"]
+    xs = track.get_xdata()
+    # Only the part inside the span [2 s, 4 s]: x from 1 m to 3 m, not its clamped ends.
+    assert xs.min() == pytest.approx(1.0, abs=0.11) and xs.max() == pytest.approx(3.0, abs=0.11)
+    t_end = res["trajectory"][-1][0]
+    assert len(xs) == pytest.approx(2.0 / 0.1 + 1, abs=2) and t_end > 4.0

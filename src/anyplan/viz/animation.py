@@ -186,6 +186,8 @@ def animate_run(scenario: Scenario, result: Any, path: str | Path, *, speed: flo
             px, py = o.position(t)
             patch.center = (px, py)
             label.set_position((px, py + o.radius + 0.05))
+            patch.set_visible(o.motion.exists(t))
+            label.set_visible(o.motion.exists(t))
         if plans:
             j = int(np.searchsorted(plan_times, t, side="right")) - 1
             if j >= 0:

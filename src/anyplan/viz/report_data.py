@@ -150,7 +150,9 @@ def _scene(sc: Scenario) -> dict[str, Any]:
             "robot_radius": r.radius, "start": [float(v) for v in r.start],
             "goal": [float(v) for v in r.goal],
             "goal_tolerance": r.goal_tolerance,
-            "movers": [{"name": o.name, "radius": o.radius} for o in sc.moving_obstacles]}
+            "movers": [{"name": o.name, "radius": o.radius,
+                        "span": [_num(v, 3) if math.isfinite(v) else None for v in o.motion.span]}
+                       for o in sc.moving_obstacles]}
 
 
 def _track(res: Mapping[str, Any], ts: np.ndarray) -> dict[str, Any]:

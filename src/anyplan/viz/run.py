@@ -168,9 +168,15 @@ def draw_run(ax: Any, scenario: Scenario, result: Any, *, marked_times: Sequence
     time_requests = []
     for j, o in enumerate(scenario.moving_obstacles):
         col = colors[j]
-        p = o.motion.positions(ts)
+        lo, hi = o.motion.span  # a recorded track exists only within its span
+        alive = (ts >= lo) & (ts <= hi)
+        if not np.any(alive):
+            continue
+        p = o.motion.positions(ts[alive])
         ax.plot(p[:, 0], p[:, 1], ls="--", lw=0.9, color=col, zorder=3)
         for tm in times:
+            if not o.motion.exists(tm):
+                continue
             q = o.motion.position(tm)
             ax.add_patch(CirclePatch(tuple(q), o.radius, fc=col, ec=col, alpha=0.18, zorder=3))
             if time_labels and not many:
@@ -178,7 +184,7 @@ def draw_run(ax: Any, scenario: Scenario, result: Any, *, marked_times: Sequence
         q1 = p[-1]
         ax.add_patch(CirclePatch(tuple(q1), o.radius, fc=col, ec="black", lw=0.6, alpha=0.85,
                                  zorder=4))
-        placer.add(p[0], o.name, gap_pt=o.radius * 0 + 4.0, fontsize=8, weight="bold",
+        placer.add(p[0], o.name, gap_pt=4.0, fontsize=8, weight="bold",
                    color=_darker(col, 0.8), zorder=9, path_effects=halo())
         if len(p) > 1:
             d = p[-1] - p[-2]

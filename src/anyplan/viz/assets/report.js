@@ -233,6 +233,8 @@
       ctx.strokeRect(X(v[0] - v[2] / 2), Y(v[1] + v[2] / 2), v[2] * k, v[2] * k);
     });
     sc.movers.forEach(function (o, j) {
+      var span = o.span || [null, null];  // a recorded track exists only within its span
+      if ((span[0] !== null && t < span[0]) || (span[1] !== null && t > span[1])) return;
       var x = interp(sc.t, sc.mover_xy[j][0], t), y = interp(sc.t, sc.mover_xy[j][1], t);
       ctx.fillStyle = moverColor(j); ctx.globalAlpha = 0.85;
       ctx.beginPath(); ctx.arc(X(x), Y(y), o.radius * k, 0, 2 * Math.PI); ctx.fill();
