@@ -196,7 +196,8 @@ def save_dovs_figure(scenario: Scenario, decision: Decision, t: float, path: str
     cfg, s = decision.model.cfg, decision.selection
     v0, w0 = decision.velocity
     with paper_style():
-        fig = new_figure((TEXT_WIDTH_IN, 5.4))
+        fig_h = 4.8
+        fig = new_figure((TEXT_WIDTH_IN, fig_h))
         a1, a2 = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.3, 1.0]})
         placer = draw_decision_world(a1, scenario, decision, traj, legend=False)
         a1.set_title(f"{scenario.name} at t = {t:.2f} s:\nrobot v = {v0:.3f} m/s, "
@@ -209,5 +210,6 @@ def save_dovs_figure(scenario: Scenario, decision: Decision, t: float, path: str
                    loc="lower center", ncol=2, frameon=False)
         fig.suptitle(f"DOVS decision: period T = {cfg.control_period_s:g} s, horizon $T_h$ = "
                      f"{cfg.time_horizon_s:g} s, merge = {cfg.merge}")
-        tight(fig, (0.0, 0.3, 1.0, 1.0))
+        rows = math.ceil((len(world[0]) + len(handles)) / 2)
+        tight(fig, (0.0, (0.1 + 0.165 * rows) / fig_h, 1.0, 1.0))
     return save_figure(fig, path, placers=[placer], dpi=dpi)

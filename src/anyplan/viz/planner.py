@@ -17,7 +17,7 @@ from anyplan.geometry.shapes import Circle
 from anyplan.planning.base import PlanResult
 from anyplan.planning.bitstar import PlannerData
 from anyplan.planning.problem import Problem
-from anyplan.viz.style import COLUMN_WIDTH_IN, halo, new_figure, paper_style, save_figure, tight
+from anyplan.viz.style import COLUMN_WIDTH_IN, LabelPlacer, halo, new_figure, paper_style, save_figure, tight
 
 __all__ = ["draw_planner", "save_planner_figure"]
 
@@ -33,7 +33,7 @@ def _draw_obstacles(ax: Any, problem: Problem) -> None:
 
 
 def draw_planner(ax: Any, problem: Problem, result: PlanResult,
-                 data: PlannerData | None = None, *, legend: bool = True) -> None:
+                 data: PlannerData | None = None, *, legend: bool = True) -> LabelPlacer:
     """Draw a planning query on ``ax``.
 
     Args:
@@ -42,6 +42,9 @@ def draw_planner(ax: Any, problem: Problem, result: PlanResult,
         result: The planner's result (its path is drawn in red).
         data: BIT*'s planner data (samples, tree, informed ellipse), if any.
         legend: Add a legend inside the axes.
+
+    Returns:
+        The placer of the start and goal labels (see :class:`anyplan.viz.style.LabelPlacer`).
     """
     _draw_obstacles(ax, problem)
     ax.plot([], [], "s", color="0.35", label="obstacle")
@@ -67,13 +70,13 @@ def draw_planner(ax: Any, problem: Problem, result: PlanResult,
     if result.path.shape[0]:
         ax.plot(result.path[:, 0], result.path[:, 1], "-", color="tab:red", lw=2.0, zorder=5,
                 label=f"path {result.cost:.3f} m")
-    for p, c, lab in ((problem.start, "tab:green", "start"), (problem.goal, "tab:orange", "goal")):
-        ax.add_patch(CirclePatch(tuple(p), max(problem.radius, 0.05), color=c, zorder=6))
-        ax.annotate(lab, tuple(p), xytext=(5, 5), textcoords="offset points", fontsize=8,
-                    path_effects=halo(), zorder=7)
     xmin, ymin, xmax, ymax = problem.bounds
     ax.set_xlim(xmin - 0.2, xmax + 0.2)
     ax.set_ylim(ymin - 0.2, ymax + 0.2)
+    placer = LabelPlacer(ax)
+    for p, c, lab in ((problem.start, "tab:green", "start"), (problem.goal, "tab:orange", "goal")):
+        ax.add_patch(CirclePatch(tuple(p), max(problem.radius, 0.05), color=c, zorder=6))
+        placer.add(tuple(p), lab, gap_pt=5.0, fontsize=8, path_effects=halo(), zorder=7)
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
@@ -83,6 +86,8 @@ def draw_planner(ax: Any, problem: Problem, result: PlanResult,
     ax.set_title(f"{result.planner}: {result.status.value}{first}{lb}", fontsize=8)
     if legend:
         ax.legend(loc="upper left", framealpha=0.8)
+    placer.layout()
+    return placer
 
 
 def save_planner_figure(problem: Problem, result: PlanResult, path: str | Path,
@@ -93,9 +98,11 @@ def save_planner_figure(problem: Problem, result: PlanResult, path: str | Path,
     w = COLUMN_WIDTH_IN
     h = 0.85 * w * (ymax - ymin) / max(xmax - xmin, 1e-9)
     with paper_style():
-        fig = new_figure((w, h + 1.6))
+        handles_rows = 2 + (data is not None)
+        fig_h = h + 0.75 + 0.17 * handles_rows
+        fig = new_figure((w, fig_h))
         ax = fig.add_subplot()
-        draw_planner(ax, problem, result, data, legend=False)
+        placer = draw_planner(ax, problem, result, data, legend=False)
         fig.legend(*ax.get_legend_handles_labels(), loc="lower center", ncol=2, frameon=False)
-        tight(fig, (0.0, 0.16, 1.0, 1.0))
-    save_figure(fig, path)
+        tight(fig, (0.0, (0.08 + 0.16 * handles_rows) / fig_h, 1.0, 1.0))
+    save_figure(fig, path, placers=[placer])

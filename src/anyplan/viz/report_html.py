@@ -15,6 +15,7 @@ from __future__ import annotations
 import base64
 import html
 import json
+import math
 from collections.abc import Mapping, Sequence
 from importlib import resources
 from pathlib import Path
@@ -162,6 +163,17 @@ def _experiments(data: Mapping[str, Any]) -> str:
     return _table(headers, rows)
 
 
+def _finite(obj: Any) -> Any:
+    """``obj`` with every non-finite float replaced by None (JSON has no NaN or infinity)."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, Mapping):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_finite(v) for v in obj]
+    return obj
+
+
 def render_page(data: Mapping[str, Any], ptables: Sequence[PlannerTable],
                 figures: Sequence[tuple[str, bytes]], out: Path) -> Path:
     """Write ``out`` (the HTML file) from the report data, the paper comparison tables and the
@@ -194,7 +206,7 @@ def render_page(data: Mapping[str, Any], ptables: Sequence[PlannerTable],
     }
     sections = "".join(f"<section id='{sid}'><h2>{_e(title)}</h2>{body[sid]}</section>"
                        for sid, title in SECTIONS)
-    blob = json.dumps(data, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
+    blob = json.dumps(_finite(data), separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
     page = ("<!doctype html><html lang='en'><head><meta charset='utf-8'>"
             "<meta name='viewport' content='width=device-width,initial-scale=1'>"
             "<title>anyplan benchmark report</title><style>" + _asset("report.css") + "</style></head><body>"
