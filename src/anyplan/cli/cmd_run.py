@@ -67,7 +67,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     checks.writable_folder(out, "run: --out")
     checks.writable_file(out / "result.json", "run: --out")
     if not args.no_plot:
-        checks.writable_file(out / "run.png", "run: --out")
+        checks.writable_file(out / f"run.{args.format}", "run: --out")
     if args.animate:
         from anyplan.viz.animation import check_target
 
