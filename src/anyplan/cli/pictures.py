@@ -21,6 +21,7 @@ def picture_path(target: str, fmt: str | None, command: str, option: str) -> Pat
     if fmt is not None and suffix in FORMATS and suffix != fmt:
         raise UsageError(f"{command}: {option} {shown}: the suffix says {suffix}, --format says {fmt}")
     if fmt is None and suffix not in FORMATS:
-        raise UsageError(f"{command}: {option} {shown}: a picture must end in .png, .svg or .pdf "
-                         "(or give --format)")
+        kind = f"unknown file type {shorten(path.suffix, 12)}" if path.suffix else "no file type"
+        raise UsageError(f"{command}: {option} {shown}: {kind}; a picture must end in .png, .svg "
+                         "or .pdf (or give --format)")
     return path if fmt is None or suffix == fmt else path.with_name(path.name + "." + fmt)
