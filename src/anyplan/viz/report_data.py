@@ -146,7 +146,9 @@ def _scene(sc: Scenario) -> dict[str, Any]:
         else:
             statics.append({"name": o.name, "polygon": np.round(np.asarray(s.vertices), 4).tolist()})
     r = sc.robot
-    return {"name": sc.name, "width": sc.width, "height": sc.height, "statics": statics,
+    x0, y0, _, _ = sc.bounds
+    return {"name": sc.name, "x0": x0, "y0": y0, "width": sc.width, "height": sc.height,
+            "statics": statics, "static_map": sc.static_map is not None,
             "robot_radius": r.radius, "start": [float(v) for v in r.start],
             "goal": [float(v) for v in r.goal],
             "goal_tolerance": r.goal_tolerance,

@@ -206,9 +206,10 @@
     var sc = PB.scene, tr = PB.track;
     if (!sc || !tr) return;
     var m = 14, k = Math.min((cv.width - 2 * m) / sc.width, (cv.height - 2 * m) / sc.height);
-    var X = function (x) { return m + x * k; }, Y = function (y) { return cv.height - m - y * k; };
+    var ox = sc.x0 || 0, oy = sc.y0 || 0;  // the arena's lower-left corner [m]
+    var X = function (x) { return m + (x - ox) * k; }, Y = function (y) { return cv.height - m - (y - oy) * k; };
     ctx.clearRect(0, 0, cv.width, cv.height);
-    ctx.lineWidth = 2; ctx.strokeStyle = "#000"; ctx.strokeRect(X(0), Y(sc.height), sc.width * k, sc.height * k);
+    ctx.lineWidth = 2; ctx.strokeStyle = "#000"; ctx.strokeRect(X(ox), Y(oy + sc.height), sc.width * k, sc.height * k);
     ctx.font = "12px sans-serif"; ctx.textAlign = "center"; ctx.textBaseline = "middle";
     sc.statics.forEach(function (o) {
       ctx.fillStyle = "#b0b0b0"; ctx.strokeStyle = "#424242"; ctx.lineWidth = 1;
@@ -287,7 +288,8 @@
     cv.width = w; cv.height = Math.round(w * (sc.height + 0.25) / (sc.width + 0.25));
     slider.max = String(tr.t[tr.t.length - 1]); slider.step = String(D.meta.playback_dt_s / 4);
     document.getElementById("pb-title").textContent = "Run " + run.id + ": " + run.planner + " on " + run.scenario +
-      ", run " + run.run_index + ", seed " + run.seed + ": " + run.outcome;
+      ", run " + run.run_index + ", seed " + run.seed + ": " + run.outcome +
+      (sc.static_map ? " (the scenario's occupancy map is not drawn here)" : "");
     Array.prototype.forEach.call(runsTable.tBodies[0].rows, function (r) {
       r.classList.toggle("selected", r.getAttribute("data-id") === String(id));
     });
