@@ -93,7 +93,7 @@ def _prediction() -> str:
     lines = ["| scene | noise [m] | samples | ADE CV | FDE CV | ADE ours | FDE ours | coverage (all) "
              "| coverage <= 2 s | mean extra radius at 1.2 / 2.0 / 4.8 s [m] |", "|" + "---|" * 10]
     for f in ("eth_hotel", "ucy_zara01"):
-        s = trajectory_samples(read_obsmat(SHARED / "crowds" / f"{f}_obsmat.txt"), stride=1)
+        s = trajectory_samples(read_obsmat(SHARED / "crowds" / f"{f}_obsmat.txt"), stride=2)
         for noise in (0.0, 0.05):
             r = evaluate_prediction(s, noise_m=noise, seed=0)
             c, e = np.array(r.coverage_by_horizon), np.array(r.mean_extra_by_horizon)
@@ -176,6 +176,9 @@ def main(argv: list[str] | None = None) -> int:
         with ProcessPoolExecutor(a.jobs) as ex:
             for k, r in enumerate(ex.map(_run, tasks), 1):
                 rows.append(r)
+                if a.out:  # partial results survive an interruption
+                    Path(a.out).write_text("\n".join(report) + f"\n## Runs ({k}/{len(tasks)} done)\n\n"
+                                           + _table(rows) + "\n")
                 print(f"[{k}/{len(tasks)} {time.perf_counter() - t0:.0f} s] {r['suite']} {r['mode']} "
                       f"{r['planner']} {r['scenario']}: {r['status']}", file=sys.stderr, flush=True)
         tab = _table(rows)
