@@ -19,7 +19,8 @@ FIELDS = {
 
 def test_run_writes_the_result_contract_and_picture(tmp_path, capsys):
     out = tmp_path / "r"
-    assert main(["run", "paper-1", "--planner", "straight", "--seed", "4", "--out", str(out)]) == 0
+    # exit code 1: the straight robot collides; result.json and run.png are written all the same
+    assert main(["run", "paper-1", "--planner", "straight", "--seed", "4", "--out", str(out)]) == 1
     res = json.loads((out / "result.json").read_text())
     for k, typ in FIELDS.items():
         assert isinstance(res[k], typ), k

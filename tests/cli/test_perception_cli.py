@@ -29,7 +29,7 @@ def test_run_records_the_perception_mode(tmp_path):
     out = tmp_path / "r"
     assert main(["run", "paper-1", "--planner", "straight", "--out", str(out), "--no-plot",
                  "--perception", "tracked", "--sensor-noise", "0.2", "--sensor-rate", "5",
-                 "--time-limit", "3"]) == 0
+                 "--time-limit", "3"]) == 1  # exit code 1: a 3 s run times out; result.json is written
     p = json.loads((out / "result.json").read_text())["extra"]["perception"]
     assert p["mode"] == "tracked" and p["noise_m"] == 0.2 and p["rate_hz"] == 5.0
     assert p["frames"] == 15 and p["noise_seed"][0] == 0

@@ -9,9 +9,10 @@ from typing import Any
 
 import numpy as np
 
+from anyplan.agents.plugins import discover_plugins
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.prediction.detection import Detection
-from anyplan.registry import Registry
+from anyplan.registry import LoadError, Registry
 from anyplan.world.robot import Command, RobotState
 from anyplan.world.scenario import Scenario
 
@@ -88,6 +89,13 @@ class Agent(abc.ABC):
 
     #: Registry name, set by subclasses.
     name: str = "agent"
+    #: Dataclasses whose fields the constructor also accepts as keywords (``--set`` lists them).
+    config_classes: tuple[type, ...] = ()
+    #: Settings that make a run depend only on scenario, settings and seed (``--deterministic``);
+    #: ``{}`` for an agent that is deterministic as it is, None for one without such a mode.
+    deterministic_settings: dict[str, Any] | None = None
+    #: Keys of ``stats.extra`` that hold wall-clock measurements (they differ from run to run).
+    wall_clock_extra: tuple[str, ...] = ()
 
     def __init__(self) -> None:
         self.stats = AgentStats()
@@ -108,9 +116,23 @@ AGENTS.register("seq-bitstar", "anyplan.agents.sequential:SequentialBITStarAgent
 AGENTS.register("dovs", "anyplan.agents.dovs:DOVSAgent")
 AGENTS.register("st-bitstar", "anyplan.agents.spacetime:SpaceTimeBITStarAgent")
 AGENTS.register("orca", "anyplan.agents.orca:ORCAAgent")  # optional extra: pyrvo
+AGENTS.register("policy", "anyplan.agents.policy:PolicyAgent")  # e.g. trained in anyplan.gym
+AGENTS.set_discovery(discover_plugins)  # third-party agents: entry-point group "anyplan.agents"
 
 
 def make_agent(name: str, **config: Any) -> Agent:
-    """Instantiate the agent registered as ``name`` with keyword ``config``."""
+    """A new agent, registered as ``name`` (built-in or plugin), with keyword ``config``.
+
+    Each call builds a fresh object; :func:`~anyplan.simulation.simulate` also starts its
+    ``stats`` empty, so nothing carries over from one run to the next.
+
+    Raises:
+        UnknownNameError: no planner has that name.
+        LoadError: a plugin's module cannot be imported.
+        LoadError: the registered object is not an :class:`Agent` class either.
+    """
     cls = AGENTS.get(name)
+    if not (isinstance(cls, type) and issubclass(cls, Agent)):
+        raise LoadError(f"planner '{name}' ({AGENTS.origin(name)}) is not an anyplan.agents.Agent "
+                        f"subclass: {cls!r}")
     return cls(**config)

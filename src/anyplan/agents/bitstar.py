@@ -45,6 +45,7 @@ class BITStarAgent(Agent):
     name = "bitstar"
     #: Kernel parts this agent uses (:func:`~anyplan.agents.warmup.warm_up_kernels`).
     kernel_parts = ("bitstar", "motion")
+    wall_clock_extra = ("bitstar_time_s", "motion_time_s", "progress")
 
     def __init__(self, time_budget_s: float = 0.5, plan_margin: float = 0.03,
                  smooth_margin: float = 0.015, max_attempts: int = 3,

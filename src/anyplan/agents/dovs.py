@@ -45,6 +45,8 @@ class DOVSAgent(Agent):
     """
 
     name = "dovs"
+    config_classes = (DOVSConfig,)
+    deterministic_settings: dict = {}  # noqa: RUF012 - commands do not depend on the clock
 
     def __init__(self, config: DOVSConfig | None = None, use_robot_limits: bool = True,
                  **overrides: Any) -> None:

@@ -87,6 +87,12 @@ class SequentialBITStarAgent(Agent):
     name = "seq-bitstar"
     #: Kernel parts this agent uses (:func:`~anyplan.agents.warmup.warm_up_kernels`).
     kernel_parts = ("bitstar", "motion", "sequential")
+    config_classes = (SequentialConfig,)
+    #: A fixed simulated planning delay [s], a batch budget instead of a time budget, and a
+    #: wall-clock cap far above any planning time: the run no longer depends on the machine.
+    deterministic_settings = {"planning_delay": 0.1, "batches_per_plan": 2,  # noqa: RUF012
+                              "max_time_s": 10.0}
+    wall_clock_extra = ("plan_time_s", "motion_time_s", "progress", "late_plans")
 
     def __init__(self, config: SequentialConfig | None = None, *, plan_margin: float = 0.03,
                  smooth_margin: float = 0.015, check_period_s: float = 0.2,

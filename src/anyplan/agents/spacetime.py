@@ -27,6 +27,7 @@ current motion is predicted to collide (the check runs every ``check_period_s``)
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Any
@@ -47,6 +48,7 @@ from anyplan.world.scenario import Scenario
 __all__ = ["SpaceTimeBITStarAgent"]
 
 _DEFAULT_LOOP = SequentialConfig(max_iterations=8, wait_delays_s=(), max_time_s=0.3)
+_LOOP_FIELDS = frozenset(f.name for f in dataclasses.fields(SequentialConfig))
 _WARM = False
 #: How far ahead [s] a motion in use is checked (a hold lasts "for ever").
 _CHECK_HORIZON_S = 60.0
@@ -108,7 +110,12 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     def __init__(self, config: SequentialConfig | None = None, *, patience_s: float = 3.0,
                  max_wait_s: float = 30.0, lattice_dt_s: float = 0.25, accept_s: float = 0.5,
                  **kwargs: Any) -> None:
-        super().__init__(config if config is not None else _DEFAULT_LOOP, **kwargs)
+        loop = {k: kwargs.pop(k) for k in list(kwargs) if k in _LOOP_FIELDS}  # e.g. from --set
+        if config is None:
+            config = dataclasses.replace(_DEFAULT_LOOP, **loop)
+        elif loop:
+            raise ValueError("give either config or loop options, not both")
+        super().__init__(config, **kwargs)
         for name, val in (("patience_s", patience_s), ("max_wait_s", max_wait_s),
                           ("lattice_dt_s", lattice_dt_s)):
             if not (isinstance(val, int | float) and val > 0.0):

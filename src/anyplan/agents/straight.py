@@ -27,6 +27,7 @@ class StraightAgent(Agent):
     """
 
     name = "straight"
+    deterministic_settings: dict = {}  # noqa: RUF012 - no clock involved
 
     def __init__(self, heading_gain: float = 2.0, align_tolerance: float = 0.05) -> None:
         super().__init__()

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from anyplan.cli import checks
+from anyplan.cli.agent_options import add_agent_options
 
 DESCRIPTION = """\
 Run every (scenario, planner, run) in parallel processes (or on a Dask cluster) and store each
@@ -24,8 +25,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--suite", default="paper",
                    help="'paper' (paper-1..3), 'random' (generated), a folder of scenario YAML "
                         "files, or a comma-separated list of files/built-in names (default paper)")
-    p.add_argument("--planners", default="straight",
-                   help="comma-separated planner names (default straight)")
+    p.add_argument("--planners", default=None,
+                   help="comma-separated planner names (default: the paper's comparison, "
+                        f"{default_bench_planners()}; 'anyplan planners' lists them all)")
     p.add_argument("--config", action="append", default=[], metavar="NAME=JSON",
                    help="keyword config of one planner as a JSON object, e.g. "
                         "'bitstar={\"time_budget_s\": 0.2}' (repeatable; recorded in plannerConfigs)")
@@ -53,6 +55,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     from anyplan.cli.perception_opts import add_perception_options
 
     add_perception_options(p)
+    add_agent_options(p, bench=True)
     p.set_defaults(func=_database_errors(cmd_bench))
 
     q = sub.add_parser("bench-planning", help="anytime planning benchmark: our BIT* beside OMPL",
@@ -60,18 +63,21 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "OMPL's planners (optional ompl wheel) for --budget seconds per run, and store "
                        "best cost against planning time in the results database (progress table); "
                        "'anyplan report' draws it. Runs one at a time (wall-clock costs).")
-    q.add_argument("--suite", default="paper", help="as for 'anyplan bench' (default paper)")
+    q.add_argument("--suite", default="planning",
+                   help="as for 'anyplan bench', or 'planning' (the default): the peers problem and "
+                        "random cluttered worlds where the straight line is blocked")
     q.add_argument("--runs", type=checks.count(checks.MAX_RUNS), default=10,
                    help="runs per (scenario, planner) (default 10)")
     q.add_argument("--budget", type=checks.positive_seconds, default=1.0,
                    help="planning time per run [s] (default 1)")
-    q.add_argument("--ompl", default="BITstar,InformedRRTstar,RRTstar",
-                   help="OMPL geometric planners, comma-separated, or 'none' "
-                        "(default BITstar,InformedRRTstar,RRTstar)")
+    q.add_argument("--ompl", default="auto",
+                   help="OMPL geometric planners, comma-separated, or 'none'; default 'auto': "
+                        "BITstar,InformedRRTstar,RRTstar when the ompl wheel is installed, else none")
     q.add_argument("--db", default="results.db", help="SQLite results database (default results.db)")
     q.add_argument("--seed", type=checks.seed, default=0, help="master seed (default 0)")
     q.add_argument("--random-count", type=checks.count(1000), default=1,
-                   help="--suite random: see 'anyplan bench'")
+                   help="--suite random: see 'anyplan bench'; --suite planning: 4 x this many "
+                        "cluttered worlds (default 1)")
     q.add_argument("--resume", action="store_true", help="run only the runs missing from --db")
     q.add_argument("--no-progress", action="store_true", help="no progress bar")
     q.set_defaults(func=_database_errors(cmd_bench_planning))
@@ -112,6 +118,14 @@ def _database_errors(fn):  # noqa: ANN001, ANN202
     return wrapper
 
 
+def default_bench_planners() -> str:
+    """``seq-bitstar,dovs``, and ``st-bitstar`` where it is registered."""
+    from anyplan.agents.base import AGENTS
+
+    names = ["seq-bitstar", "dovs", "st-bitstar"]
+    return ",".join(n for n in names if n in AGENTS)
+
+
 def _usage(msg: str) -> Exception:
     from anyplan.cli.main import UsageError
 
@@ -139,7 +153,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
         raise _usage(f"bench: --jobs must be >= 1, got {args.jobs}")
     if args.jobs > checks.MAX_JOBS:
         raise _usage(f"bench: --jobs must be <= {checks.MAX_JOBS} (the stated limit), got {args.jobs}")
-    planners = parse_planners(args.planners, args.config)
+    planners = parse_planners(args.planners or default_bench_planners(), args.config)
+    if args.set_options or args.deterministic:
+        from anyplan.cli.agent_options import bench_configs
+        from anyplan.experiments.runner import PlannerSpec
+
+        cfgs = bench_configs(args, [p.name for p in planners], {p.name: dict(p.config) for p in planners})
+        planners = [PlannerSpec(p.name, cfgs[p.name]) for p in planners]
     scenarios = resolve_suite(args.suite, random_seed=args.seed if args.random_seed is None
                               else args.random_seed, per_count=args.random_count)
     from anyplan.cli.perception_opts import apply_perception
@@ -209,9 +229,24 @@ def cmd_bench_planning(args: argparse.Namespace) -> int:
     from anyplan.experiments.planning_bench import planning_table, run_planning_bench
     from anyplan.experiments.suites import resolve_suite
 
-    scenarios = resolve_suite(args.suite, random_seed=args.seed, per_count=args.random_count)
-    names = [n.strip() for n in args.ompl.split(",") if n.strip()]
-    ompl = [] if args.ompl.strip().lower() == "none" else names
+    from anyplan.experiments.planning_bench import OMPL_DEFAULT, ompl_available
+
+    if args.suite == "planning":
+        from anyplan.experiments.planning_problems import planning_suite
+
+        if args.random_count < 1:
+            raise _usage(f"bench-planning: --random-count must be >= 1, got {args.random_count}")
+        scenarios = planning_suite(args.seed, count=4 * args.random_count)
+    else:
+        scenarios = resolve_suite(args.suite, random_seed=args.seed, per_count=args.random_count)
+    choice = args.ompl.strip().lower()
+    if choice == "auto":
+        ompl = list(OMPL_DEFAULT) if ompl_available() else []
+        if not ompl:
+            sys.stderr.write("anyplan: the ompl wheel is not installed: our BIT* alone "
+                             "(pip install 'anyplan[bench]' adds OMPL's planners)\n")
+    else:
+        ompl = [] if choice == "none" else [n.strip() for n in args.ompl.split(",") if n.strip()]
     db_path = Path(args.db)
     if args.resume and not db_path.exists():
         raise _usage(f"bench-planning: --resume: {db_path} does not exist")

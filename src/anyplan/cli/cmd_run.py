@@ -8,18 +8,26 @@ from pathlib import Path
 
 from anyplan.agents.base import AGENTS, make_agent
 from anyplan.cli import checks
+from anyplan.cli.agent_options import add_agent_options, run_config
 from anyplan.cli.perception_opts import add_perception_options, apply_perception
 from anyplan.simulation.simulator import SimConfig, simulate
 from anyplan.world.scenario import builtin_scenarios, load_scenario
 
 DEFAULT_PLANNER = "seq-bitstar"
 
+EXIT_CODES = """\
+exit codes:
+  0  the robot reached the goal
+  1  the run collided or timed out (result.json and run.png are still written)
+  2  bad input (unknown scenario, planner or setting, malformed file or option)"""
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``run`` and ``scenarios`` sub-commands."""
     p = sub.add_parser("run", help="simulate a planner on a scenario",
                        description="Simulate a planner on a scenario; writes DIR/result.json "
-                       "and DIR/run.png (or --format svg/pdf) and prints a summary.")
+                       "and DIR/run.png (or --format svg/pdf) and prints a summary.", epilog=EXIT_CODES,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("scenario", help="built-in scenario name (see 'anyplan scenarios') or YAML file")
     p.add_argument("--planner", default=DEFAULT_PLANNER,
                    help=f"planner name (default {DEFAULT_PLANNER}; one of: {', '.join(AGENTS.names())})")
@@ -37,6 +45,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--speed", type=checks.playback_speed, default=4.0,
                    help="animation playback speed, x real time (default 4)")
     add_perception_options(p)
+    p.add_argument("--mcap", default=None, metavar="FILE",
+                   help="also write the run as an MCAP file with ROS 2 messages (poses, plans, "
+                        "obstacles; for Foxglove, RViz, ros2 bag); needs the 'mcap' extra")
+    add_agent_options(p)
     p.set_defaults(func=cmd_run)
 
     s = sub.add_parser("scenarios", help="list the built-in scenarios")
@@ -55,7 +67,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from anyplan.cli.main import UsageError
 
     scenario = apply_perception("run", [load_scenario(args.scenario)], args)[0]
-    AGENTS.get(args.planner)  # unknown names fail here, before any work
+    config = run_config(args, args.planner)  # unknown names and bad settings fail before any work
     try:
         cfg = SimConfig(dt=args.dt, time_limit=args.time_limit)
         cfg.steps(scenario.time_limit)
@@ -76,7 +88,11 @@ def cmd_run(args: argparse.Namespace) -> int:
             check_target(args.animate, args.speed)
         except ValueError as exc:
             raise UsageError(f"run: --animate: {exc}") from None
-    agent = make_agent(args.planner)
+    if args.mcap:  # check the extra and the target before simulating
+        from anyplan.experiments.mcap_log import check_target as check_mcap
+
+        check_mcap(args.mcap)
+    agent = make_agent(args.planner, **config)
     _prepare_kernels(getattr(agent, "kernel_parts", ()))
     result = simulate(scenario, agent, seed=args.seed, config=cfg)
     (out / "result.json").write_text(json.dumps(result.to_dict(), indent=1))
@@ -85,13 +101,15 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         save_run_figure(scenario, result, out / f"run.{args.format}")
     print(summary(result, out))
+    if args.mcap:
+        from anyplan.experiments.mcap_log import write_mcap
+
+        print(f"  ROS 2 log      {write_mcap(args.mcap, scenario, result).path}")
     if args.animate:
         from anyplan.viz.animation import animate_run
 
         print(f"  animation      {animate_run(scenario, result, args.animate, speed=args.speed)}")
-    if result.status == "unreachable":  # proven before the run: the goal cannot be reached
-        return 1
-    return 0
+    return 0 if result.reached_goal else 1
 
 
 def _prepare_kernels(parts: tuple[str, ...]) -> None:

@@ -30,6 +30,7 @@ COMMAND_MODULES = [
     "anyplan.cli.cmd_crowd",
     "anyplan.cli.cmd_plan",
     "anyplan.cli.cmd_dovs",
+    "anyplan.cli.cmd_planners",
 ]
 
 

@@ -44,10 +44,11 @@ from anyplan.simulation.feasibility import goal_unreachable
 from anyplan.simulation.metrics import moving_obstacle_metrics
 from anyplan.simulation.perception import Sensor, effective_sensing, observe_exact, with_tracking
 from anyplan.world.limits import MAX_SIM_STEPS, MAX_TIME_LIMIT_S, MIN_DT_S
-from anyplan.world.robot import RobotState, step
+from anyplan.world.robot import Command, RobotState, step
 from anyplan.world.scenario import Scenario
 
-__all__ = ["SimConfig", "RunResult", "simulate"]
+__all__ = ["SimConfig", "RunResult", "Simulation", "simulate", "observe", "WALL_CLOCK_FIELDS",
+           "without_wall_clock"]
 
 
 @dataclass(frozen=True)
@@ -103,6 +104,12 @@ class RunResult:
     ``time_lower_bound_s`` is the least time from rest to the edge of the goal tolerance along
     the static shortest path (:func:`anyplan.planning.time_bound.scenario_time_lower_bound`;
     None without a path) and ``time_over_lower_bound`` the time to goal over it.
+
+    ``wall_clock_fields`` names the fields measured in wall-clock time (``wall_time_s``,
+    ``planning_times_s`` and the agent's ``extra.*`` timings): they differ from run to run and
+    machine to machine. Every other field is a function of the scenario, the planner settings
+    and the seed when the planner runs deterministically (``--deterministic``);
+    :meth:`reproducible_dict` leaves the wall-clock fields out.
     """
 
     scenario: str
@@ -134,15 +141,36 @@ class RunResult:
     #: and time [s] within 0.2 m of one (:mod:`anyplan.simulation.metrics`).
     min_distance_to_moving_m: float | None = None
     discomfort_time_s: float = 0.0
+    wall_clock_fields: list[str] = field(default_factory=lambda: list(WALL_CLOCK_FIELDS))
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-serialisable dictionary."""
         return _jsonable(asdict(self))
 
+    def reproducible_dict(self) -> dict[str, Any]:
+        """:meth:`to_dict` without the wall-clock fields."""
+        return without_wall_clock(self.to_dict())
+
     @property
     def trajectory_array(self) -> np.ndarray:
         """The trajectory as an array, shape (N, 6)."""
         return np.asarray(self.trajectory, dtype=float).reshape(-1, 6)
+
+
+#: Fields of every result measured in wall-clock time.
+WALL_CLOCK_FIELDS = ("wall_time_s", "planning_times_s")
+
+
+def without_wall_clock(result: dict[str, Any]) -> dict[str, Any]:
+    """A ``result.json`` dictionary without the fields it lists in ``wall_clock_fields``."""
+    out = dict(result)
+    out["extra"] = dict(out.get("extra") or {})
+    for name in result.get("wall_clock_fields", WALL_CLOCK_FIELDS):
+        if name.startswith("extra."):
+            out["extra"].pop(name[len("extra."):], None)
+        else:
+            out.pop(name, None)
+    return out
 
 
 def _jsonable(obj: Any) -> Any:
@@ -170,85 +198,137 @@ def observe(scenario: Scenario, t: float, robot: RobotState,
     return observe_exact(scenario, t, robot, announce)
 
 
-def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
-             config: SimConfig | None = None) -> RunResult:
-    """Run ``agent`` on ``scenario`` until the goal, a collision or the time limit.
+class Simulation:
+    """The simulator as a steppable object: one control step per :meth:`step`.
+
+    :func:`simulate` drives it with an agent; a Gymnasium environment (:mod:`anyplan.gym`) drives
+    it with actions. The physics, the collision test and the metrics are the same.
 
     Args:
-        scenario: The full scenario (the agent only gets its static part).
-        agent: A fresh agent; it is reset here.
-        seed: Seed of the agent's random generator (recorded in the result).
+        scenario: The full scenario (truth).
         config: Simulation settings.
+        seed: Seed of the sensor's noise (perception modes with noise).
+
+    Attributes:
+        t: Simulation time [s] of the current state.
+        state: The robot's current pose and twist.
+        done: True once the run is over (goal, collision with ``stop_on_collision``, time limit).
+        status: ``"running"``, then ``"reached"``, ``"collision"`` or ``"timeout"``.
+        trajectory: Rows ``[t, x, y, theta, v, omega]``, one per step so far.
     """
-    cfg = config or SimConfig()
-    dt = cfg.dt
-    n_max = cfg.steps(scenario.time_limit)
-    spec = scenario.robot
-    r = spec.radius
-    obstacles = scenario.obstacle_set()
-    movers = scenario.moving_obstacles
-    wall0 = time.perf_counter()
-    sensor = Sensor(scenario, effective_sensing(scenario, cfg.announce_motions), seed)
-    agent = with_tracking(agent, sensor.spec)
-    unreachable = cfg.check_feasibility and goal_unreachable(scenario)
-    if unreachable:
-        n_max = 0  # nothing to simulate
-    else:
-        agent.reset(scenario.static_only(), np.random.default_rng(seed))
 
-    state = RobotState(*spec.start, 0.0, 0.0)
-    t = 0.0
-    traj = [[0.0, state.x, state.y, state.theta, 0.0, 0.0]]
-    length = 0.0
-    min_clear = math.inf
-    collision_with: str | None = None
-    collision_time: float | None = None
-    caused: bool | None = None
-    approach: float | None = None
-    reached = False
-    time_to_goal: float | None = None
-    start_clear = obstacles.clearance((state.x, state.y)) - r
-    min_clear = min(min_clear, start_clear)
-    if movers:
-        p_obs = np.array([o.position(0.0) for o in movers])
-        radii = np.array([o.radius for o in movers])
-        d0 = np.hypot(p_obs[:, 0] - state.x, p_obs[:, 1] - state.y) - radii - r
-        alive0 = [o.motion.exists(0.0) for o in movers]
-        if any(alive0):
-            min_clear = min(min_clear, float(d0[alive0].min()))
-    else:
-        p_obs = np.zeros((0, 2))
-        radii = np.zeros(0)
+    def __init__(self, scenario: Scenario, config: SimConfig | None = None, seed: int = 0) -> None:
+        cfg = config or SimConfig()
+        self.scenario = scenario
+        self.config = cfg
+        self.dt = cfg.dt
+        self.time_limit_s = cfg.time_limit if cfg.time_limit is not None else scenario.time_limit
+        self.n_max = cfg.steps(scenario.time_limit)
+        #: True when the visibility graph proves the goal out of reach: the run ends at once.
+        self.unreachable = bool(cfg.check_feasibility and goal_unreachable(scenario))
+        if self.unreachable:
+            self.n_max = 0  # nothing to simulate
+        spec = scenario.robot
+        self._obstacles = scenario.obstacle_set()
+        self._movers = scenario.moving_obstacles
+        self.state = RobotState(*spec.start, 0.0, 0.0)
+        self.t = 0.0
+        self.steps = 0
+        self.trajectory: list[list[float]] = [[0.0, self.state.x, self.state.y, self.state.theta, 0.0, 0.0]]
+        self.path_length_m = 0.0
+        self.collision_with: str | None = None
+        self.collision_time_s: float | None = None
+        self.collision_robot_caused: bool | None = None
+        self.collision_approach_speed_mps: float | None = None
+        self._contact: tuple[float | None, bool | None] = (None, None)
+        self.reached = False
+        self.time_to_goal_s: float | None = None
+        self.last_step_clearance_m = self._obstacles.clearance((self.state.x, self.state.y)) - spec.radius
+        self.min_clearance_m = min(math.inf, self.last_step_clearance_m)
+        if self._movers:
+            self._p_obs = np.array([o.position(0.0) for o in self._movers])
+            self._radii = np.array([o.radius for o in self._movers])
+            d0 = (np.hypot(self._p_obs[:, 0] - self.state.x, self._p_obs[:, 1] - self.state.y)
+                  - self._radii - spec.radius)
+            alive0 = [o.motion.exists(0.0) for o in self._movers]
+            if any(alive0):
+                self.min_clearance_m = min(self.min_clearance_m, float(d0[alive0].min()))
+        else:
+            self._p_obs = np.zeros((0, 2))
+            self._radii = np.zeros(0)
+        self.last_hit: str | None = None
+        self.sensor = Sensor(scenario, effective_sensing(scenario, cfg.announce_motions), seed)
+        self.done = False
+        self._check_goal()
 
-    for i in range(n_max):
-        if math.hypot(state.x - spec.goal[0], state.y - spec.goal[1]) <= spec.goal_tolerance:
-            reached = True
-            time_to_goal = t
-            break
-        seen, detections = sensor.observe(t, state)
-        obs = Observation(t, state, seen, detections)
-        cmd = agent.act(obs)
+    def _at_goal(self) -> bool:
+        g = self.scenario.robot
+        return math.hypot(self.state.x - g.goal[0], self.state.y - g.goal[1]) <= g.goal_tolerance
+
+    def _check_goal(self) -> None:
+        """End the run at the goal, or (after the last step) at the time limit."""
+        if self.done:
+            return
+        if self.steps < self.n_max:
+            if self._at_goal():
+                self.reached, self.time_to_goal_s, self.done = True, self.t, True
+        else:
+            if self._at_goal():
+                self.reached, self.time_to_goal_s = True, self.t
+            self.done = True
+
+    @property
+    def status(self) -> str:
+        """``running``, ``collision``, ``reached``, ``timeout`` or ``unreachable``."""
+        if self.unreachable:
+            return "unreachable"
+        if self.collision_with is not None:
+            return "collision"
+        if self.reached:
+            return "reached"
+        return "timeout" if self.done else "running"
+
+    def observation(self) -> Observation:
+        """What an agent sees now (call it once per step: a sensor may keep state)."""
+        seen, detections = self.sensor.observe(self.t, self.state)
+        return Observation(self.t, self.state, seen, detections)
+
+    def step(self, cmd: Command) -> None:
+        """Clip ``cmd`` to the robot's limits, integrate one step, move the obstacles, test the
+        step for collisions and update the metrics.
+
+        Raises:
+            RuntimeError: the run is over.
+        """
+        if self.done:
+            raise RuntimeError("the simulation is over; make a new Simulation")
+        spec = self.scenario.robot
+        r = spec.radius
+        dt = self.dt
+        state = self.state
         new = step(spec, state, cmd, dt)
-        t_new = (i + 1) * dt
+        t0, t_new = self.t, (self.steps + 1) * dt
         a = np.array([state.x, state.y])
         b = np.array([new.x, new.y])
-        length += float(np.hypot(*(b - a)))
+        self.path_length_m += float(np.hypot(*(b - a)))
         # Static obstacles and walls: exact clearance of the step's chord.
-        c_static = obstacles.segment_clearance(a, b) - r
+        c_static = self._obstacles.segment_clearance(a, b) - r
         step_clear = c_static
         hit = None
         u = (b - a) / dt  # the robot's velocity over the step's chord [m/s]
+        first = self.collision_with is None
         if c_static < -COLLISION_EPS:
-            hit = scenario.nearest_static(a, b)
-            if collision_with is None:
-                pc = a + static_contact(obstacles, a, b, r) * (b - a)
-                q = nearest_obstacle_point(obstacles, pc)
-                approach, caused = approach_speed(u, pc, q), robot_caused(u, pc, q)
-        if movers:
-            p_new = np.array([o.position(t_new) for o in movers])
-            for j, o in enumerate(movers):
+            hit = self.scenario.nearest_static(a, b)
+            if first:
+                pc = a + static_contact(self._obstacles, a, b, r) * (b - a)
+                q = nearest_obstacle_point(self._obstacles, pc)
+                self._contact = (approach_speed(u, pc, q), robot_caused(u, pc, q))
+        if self._movers:
+            p_obs, radii = self._p_obs, self._radii
+            p_new = np.array([o.position(t_new) for o in self._movers])
+            for j, o in enumerate(self._movers):
                 lo, hi = o.motion.span  # a recorded track exists only within its span
-                s0, s1 = max(t, lo) - t, min(t_new, hi) - t
+                s0, s1 = max(t0, lo) - t0, min(t_new, hi) - t0
                 if s1 < s0:
                     continue
                 w = (p_new[j] - p_obs[j]) / dt
@@ -258,54 +338,86 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
                     step_clear = c
                 if c < -COLLISION_EPS and hit is None:
                     hit = o.name
-                    if collision_with is None:
+                    if first:
                         tc = disc_contact(a, u, p_obs[j], w, r + radii[j], s0, s1)
                         pc, q = a + u * tc, p_obs[j] + w * tc
-                        approach, caused = approach_speed(u, pc, q), robot_caused(u, pc, q)
-            p_obs = p_new
-        min_clear = min(min_clear, step_clear)
-        state, t = new, t_new
-        traj.append([t, state.x, state.y, state.theta, state.v, state.omega])
-        if hit is not None and collision_with is None:
-            collision_with, collision_time = hit, t
-            if cfg.stop_on_collision:
-                break
-    else:
-        if math.hypot(state.x - spec.goal[0], state.y - spec.goal[1]) <= spec.goal_tolerance:
-            reached, time_to_goal = True, t
+                        self._contact = (approach_speed(u, pc, q), robot_caused(u, pc, q))
+            self._p_obs = p_new
+        self.last_step_clearance_m = float(step_clear)
+        self.min_clearance_m = min(self.min_clearance_m, step_clear)
+        self.state, self.t = new, t_new
+        self.steps += 1
+        self.trajectory.append([self.t, new.x, new.y, new.theta, new.v, new.omega])
+        self.last_hit = hit
+        if hit is not None and self.collision_with is None:
+            self.collision_with, self.collision_time_s = hit, self.t
+            self.collision_approach_speed_mps, self.collision_robot_caused = self._contact
+            if self.config.stop_on_collision:
+                self.done = True
+                return
+        self._check_goal()
 
-    collided = collision_with is not None
-    status = "collision" if collided else ("reached" if reached else "timeout")
-    if unreachable:
-        status = "unreachable"
-    bound = scenario_time_lower_bound(scenario)
-    ttg = time_to_goal if reached else None
-    st = AgentStats() if unreachable else agent.stats
-    return RunResult(
-        scenario=scenario.name,
-        planner=agent.name,
-        seed=int(seed),
-        reached_goal=reached and not (collided and cfg.stop_on_collision),
-        collision=collided,
-        path_length_m=length,
-        time_to_goal_s=time_to_goal if reached else None,
-        planning_times_s=list(st.planning_times_s),
-        replans=int(st.replans),
-        min_clearance_m=float(min_clear),
-        trajectory=traj,
-        status=status,
-        collision_with=collision_with,
-        collision_time_s=collision_time,
-        virtual_obstacles=list(st.virtual_obstacles),
-        plans=list(st.plans),
-        scenario_hash=scenario.content_hash(),
-        dt_s=dt,
-        wall_time_s=time.perf_counter() - wall0,
-        extra={**st.extra, "perception": sensor.record()},
-        collision_robot_caused=caused if collided else None,
-        collision_approach_speed_mps=approach if collided else None,
-        time_lower_bound_s=bound,
-        time_over_lower_bound=(ttg / bound if ttg is not None and bound is not None and bound > 0.0
-                               else None),
-        **moving_obstacle_metrics(scenario, np.asarray(traj)),
-    )
+    def result(self, planner: str, seed: int, stats: AgentStats | None = None,
+               wall_time_s: float = 0.0) -> RunResult:
+        """The run so far as a :class:`RunResult`."""
+        st = AgentStats() if self.unreachable or stats is None else stats
+        collided = self.collision_with is not None
+        reached = self.reached
+        status = "collision" if collided else ("reached" if reached else "timeout")
+        if self.unreachable:
+            status = "unreachable"
+        bound = scenario_time_lower_bound(self.scenario)
+        ttg = self.time_to_goal_s if reached else None
+        return RunResult(
+            scenario=self.scenario.name,
+            planner=planner,
+            seed=int(seed),
+            reached_goal=reached and not (collided and self.config.stop_on_collision),
+            collision=collided,
+            path_length_m=self.path_length_m,
+            time_to_goal_s=self.time_to_goal_s if reached else None,
+            planning_times_s=list(st.planning_times_s),
+            replans=int(st.replans),
+            min_clearance_m=float(self.min_clearance_m),
+            trajectory=self.trajectory,
+            status=status,
+            collision_with=self.collision_with,
+            collision_time_s=self.collision_time_s,
+            virtual_obstacles=list(st.virtual_obstacles),
+            plans=list(st.plans),
+            scenario_hash=self.scenario.content_hash(),
+            dt_s=self.dt,
+            wall_time_s=wall_time_s,
+            extra={**st.extra, "perception": self.sensor.record()},
+            collision_robot_caused=self.collision_robot_caused if collided else None,
+            collision_approach_speed_mps=self.collision_approach_speed_mps if collided else None,
+            time_lower_bound_s=bound,
+            time_over_lower_bound=(ttg / bound if ttg is not None and bound is not None and bound > 0.0
+                                   else None),
+            **moving_obstacle_metrics(self.scenario, np.asarray(self.trajectory)),
+        )
+
+
+def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
+             config: SimConfig | None = None) -> RunResult:
+    """Run ``agent`` on ``scenario`` until the goal, a collision or the time limit.
+
+    Args:
+        scenario: The full scenario (the agent only gets its static part).
+        agent: The agent; it is reset here, and its ``stats`` start empty, so that an agent
+            object used for several runs reports each run alone.
+        seed: Seed of the agent's random generator (recorded in the result).
+        config: Simulation settings.
+    """
+    wall0 = time.perf_counter()
+    sim = Simulation(scenario, config, seed)
+    wall_clock_extra = getattr(agent, "wall_clock_extra", ())
+    agent = with_tracking(agent, sim.sensor.spec)
+    agent.stats = AgentStats()
+    if not sim.unreachable:
+        agent.reset(scenario.static_only(), np.random.default_rng(seed))
+    while not sim.done:
+        sim.step(agent.act(sim.observation()))
+    res = sim.result(agent.name, seed, agent.stats, time.perf_counter() - wall0)
+    res.wall_clock_fields += [f"extra.{k}" for k in wall_clock_extra if k in res.extra]
+    return res

@@ -399,7 +399,7 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     top = c.mapping(data, "")
     c.keys(top, "", ("name", "robot"),
            ("arena", "description", "time_limit", "static_obstacles", "dynamic_obstacles",
-            "sensing", "static_map"))
+            "moving_obstacles", "sensing", "static_map"))
     name = c.string(top["name"], "name")
     description = top.get("description")
     if description is None:
@@ -448,8 +448,13 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     statics_raw = c.items(top.get("static_obstacles"), "static_obstacles", L.MAX_STATIC_OBSTACLES)
     statics = tuple(_parse_static(c, o, f"static_obstacles[{i}]", i)
                     for i, o in enumerate(statics_raw))
-    moving_raw = c.items(top.get("dynamic_obstacles"), "dynamic_obstacles", L.MAX_MOVING_OBSTACLES)
-    moving = tuple(_parse_moving(c, o, f"dynamic_obstacles[{i}]", i)
+    # The moving obstacles: "dynamic_obstacles" (the paper's word) or its alias "moving_obstacles".
+    mkey = "moving_obstacles" if "moving_obstacles" in top else "dynamic_obstacles"
+    if "moving_obstacles" in top and "dynamic_obstacles" in top:
+        raise c.fail("moving_obstacles", "give the moving obstacles once: moving_obstacles is another "
+                     "name for dynamic_obstacles")
+    moving_raw = c.items(top.get(mkey), mkey, L.MAX_MOVING_OBSTACLES)
+    moving = tuple(_parse_moving(c, o, f"{mkey}[{i}]", i)
                    for i, o in enumerate(moving_raw))
     names = [o.name for o in statics] + [o.name for o in moving]
     for i, n in enumerate(names):

@@ -1,0 +1,1 @@
+"""An example anyplan plugin (see ``examples/plugin/README.md``)."""

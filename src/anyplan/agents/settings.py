@@ -1,0 +1,239 @@
+"""An agent's settings, for the command line: ``--set KEY=VALUE`` and ``--deterministic``.
+
+The settings of an agent class are the keyword arguments of its ``__init__`` whose annotated type
+is a scalar (``float``, ``int``, ``bool``, ``str``, ``None``, a union of those, or a
+``tuple[float, ...]``), plus the fields of the dataclasses named in its ``config_classes``
+attribute (for ``seq-bitstar``, :class:`~anyplan.planning.sequential.SequentialConfig`; for
+``dovs``, :class:`~anyplan.baselines.dovs.config.DOVSConfig`): what it accepts as keywords through
+``**options``. This works for plugins too: their ``__init__`` signature is read the same way.
+
+``VALUE`` is parsed as a YAML scalar (``0.1``, ``2``, ``true``, ``null``, ``measured``,
+``[0.5, 1.0]``) and checked against the setting's type; an unknown key is refused with the
+nearest known one as a hint. Range checks are the agent's own (its constructor's
+``ValueError``), turned into one-line errors by :func:`build_agent_config`.
+
+``--deterministic`` applies the class's ``deterministic_settings`` (for ``seq-bitstar``: a
+fixed planning delay, a batch budget instead of a time budget, and a wall-clock cap far above
+any planning time): the run then depends only on the scenario, the settings and the seed, not
+on the machine's speed. An agent class without that attribute has no such mode.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import types
+import typing
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import yaml
+
+from anyplan.errors import AnyplanError, UnknownNameError
+
+__all__ = ["Setting", "SettingsError", "agent_settings", "parse_set_options", "build_agent_config",
+           "deterministic_settings"]
+
+_SCALARS = (float, int, bool, str, type(None))
+
+
+class SettingsError(AnyplanError, ValueError):
+    """A bad ``--set`` option or ``--deterministic`` request (exit code 2 on the command line)."""
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One settable option: ``name``, its ``default`` and its type ``hint`` (None: unannotated)."""
+
+    name: str
+    default: Any
+    hint: Any
+
+    @property
+    def type_name(self) -> str:
+        """The type in words, e.g. ``float or None``."""
+        return _hint_name(self.hint)
+
+
+def _hint_name(hint: Any) -> str:
+    if hint is None or hint is inspect.Parameter.empty:
+        return "any"
+    if hint is type(None):
+        return "None"
+    args = typing.get_args(hint)
+    if typing.get_origin(hint) in (typing.Union, types.UnionType):
+        return " or ".join(_hint_name(a) for a in args)
+    if typing.get_origin(hint) is tuple:
+        return f"list of {_hint_name(args[0])}" if args else "list"
+    if typing.get_origin(hint) is typing.Literal:
+        return " or ".join(repr(a) for a in args)
+    return getattr(hint, "__name__", str(hint))
+
+
+def _settable(hint: Any) -> bool:
+    if hint is inspect.Parameter.empty:
+        return True
+    if hint in _SCALARS:
+        return True
+    origin = typing.get_origin(hint)
+    if origin in (typing.Union, types.UnionType):
+        members = [a for a in typing.get_args(hint) if a is not type(None)]
+        return bool(members) and all(_settable(a) for a in members)
+    if origin is tuple:
+        return all(a in (float, int, Ellipsis) for a in typing.get_args(hint))
+    return origin is typing.Literal
+
+
+def _hints(obj: Any) -> dict[str, Any]:
+    try:
+        return typing.get_type_hints(obj)
+    except Exception:  # noqa: BLE001 - unresolvable annotations: treat as unannotated
+        return {}
+
+
+def agent_settings(cls: type) -> dict[str, Setting]:
+    """The settings of agent class ``cls``, by name (constructor keywords, those of the base
+    classes its ``**kwargs`` are passed on to, then config fields)."""
+    out: dict[str, Setting] = {}
+    # A constructor with **kwargs passes them on to its base class's: read that one too.
+    for klass in cls.__mro__:
+        init = klass.__dict__.get("__init__")
+        if init is None:
+            continue
+        hints = _hints(init)
+        forwards = False
+        for p in list(inspect.signature(init).parameters.values())[1:]:
+            if p.kind is p.VAR_KEYWORD:
+                forwards = True
+            if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD) or p.name in out:
+                continue
+            hint = hints.get(p.name, inspect.Parameter.empty)
+            if _settable(hint):
+                out[p.name] = Setting(p.name, None if p.default is p.empty else p.default, hint)
+        if not forwards:
+            break
+    for conf in getattr(cls, "config_classes", ()):
+        fh = _hints(conf)
+        for f in dataclasses.fields(conf):
+            hint = fh.get(f.name, inspect.Parameter.empty)
+            if f.name in out or not _settable(hint):
+                continue
+            default = f.default if f.default is not dataclasses.MISSING else None
+            out[f.name] = Setting(f.name, default, hint)
+    return out
+
+
+def _coerce(hint: Any, value: Any) -> Any:
+    """``value`` as type ``hint``; raises TypeError when it is not one."""
+    if hint is inspect.Parameter.empty:
+        return value
+    if hint is type(None):
+        if value is None:
+            return None
+        raise TypeError
+    origin = typing.get_origin(hint)
+    if origin in (typing.Union, types.UnionType):
+        members = typing.get_args(hint)
+        # Exact type matches first, so that "measured" stays a str and 2 stays an int.
+        for a in sorted(members, key=lambda a: 0 if isinstance(value, a if isinstance(a, type) else ()) else 1):
+            try:
+                return _coerce(a, value)
+            except TypeError:
+                continue
+        raise TypeError
+    if origin is typing.Literal:
+        if value in typing.get_args(hint):
+            return value
+        raise TypeError
+    if origin is tuple:
+        if not isinstance(value, list | tuple):
+            value = [value]
+        return tuple(_coerce(float, v) for v in value)
+    if hint is bool:
+        if isinstance(value, bool):
+            return value
+        raise TypeError
+    if hint is int:
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value
+        raise TypeError
+    if hint is float:
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return float(value)
+        if isinstance(value, str):  # YAML 1.1 reads 1e-3 as a string
+            try:
+                return float(value)
+            except ValueError:
+                raise TypeError from None
+        raise TypeError
+    if hint is str:
+        if isinstance(value, str):
+            return value
+        raise TypeError
+    if isinstance(value, hint):
+        return value
+    raise TypeError
+
+
+def parse_set_options(items: Sequence[str]) -> dict[str, Any]:
+    """``["KEY=VALUE", ...]`` as a dictionary, each value parsed as a YAML scalar.
+
+    Raises:
+        SettingsError: an item without ``=``, an empty key, a key given twice, or bad YAML.
+    """
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise SettingsError(f"--set: expected KEY=VALUE, got '{item}'")
+        if key in out:
+            raise SettingsError(f"--set: '{key}' is given twice")
+        try:
+            out[key] = yaml.safe_load(text) if text.strip() else ""
+        except yaml.YAMLError:
+            raise SettingsError(f"--set {key}: cannot read '{text}' as a YAML value") from None
+    return out
+
+
+def deterministic_settings(cls: type, planner: str) -> dict[str, Any]:
+    """The settings that make ``planner``'s runs independent of the machine.
+
+    Raises:
+        SettingsError: the agent has no deterministic mode.
+    """
+    det = getattr(cls, "deterministic_settings", None)
+    if det is None:
+        raise SettingsError(f"--deterministic: planner '{planner}' has no deterministic mode "
+                            "(its class sets no deterministic_settings)")
+    return dict(det)
+
+
+def build_agent_config(cls: type, planner: str, options: dict[str, Any],
+                       deterministic: bool = False) -> dict[str, Any]:
+    """The keyword config for ``cls``: its deterministic settings (if asked), then ``options``
+    checked against :func:`agent_settings`; the agent is built once to run its own checks.
+
+    Raises:
+        SettingsError: an unknown key (with the nearest known one), a value of the wrong type,
+            or a value the agent rejects.
+    """
+    known = agent_settings(cls)
+    config = deterministic_settings(cls, planner) if deterministic else {}
+    for key, value in options.items():
+        if key not in known:
+            err = UnknownNameError(f"setting of planner '{planner}'", key, list(known))
+            raise SettingsError(f"--set: {err}")
+        s = known[key]
+        try:
+            config[key] = _coerce(s.hint, value)
+        except TypeError:
+            raise SettingsError(f"--set {key}={value!r}: planner '{planner}' expects "
+                                f"{s.type_name} (default {s.default!r})") from None
+    try:
+        cls(**config)
+    except (TypeError, ValueError) as exc:
+        first = (str(exc).splitlines() or [""])[0]
+        raise SettingsError(f"--set: planner '{planner}' rejects its settings: {first}") from None
+    return config

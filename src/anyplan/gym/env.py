@@ -1,0 +1,156 @@
+"""``anyplan/Nav-v0``: drive the robot to its goal among static and moving obstacles.
+
+The environment steps :class:`anyplan.simulation.simulator.Simulation`, the simulator every
+planner runs in: the same unicycle integration, limits, collision test over each step and
+metrics; nothing is re-implemented here.
+
+* **Scenario**: ``scenario`` is a built-in name (``"paper-3"``), a YAML file, a
+  :class:`~anyplan.world.Scenario`, a list of those (a suite: each reset picks one with the
+  environment's random generator), or ``"random"`` (a new random cluttered world with 1-6 moving
+  obstacles at each reset, :func:`anyplan.experiments.generate.random_scenario`).
+* **Observation**: a float32 vector (each value within +-``OBS_BOUND``) of length
+  ``8 + 7 * max_obstacles`` built by
+  :class:`anyplan.agents.policy.ObservationEncoder` from what a planner observes (the robot's
+  state relative to the goal, then the visible moving obstacles nearest first, padded with zero
+  slots; see :mod:`anyplan.agents.policy`).
+* **Action**: ``(v, omega)`` in m/s and rad/s, within ``[-v_max, v_max] x [-omega_max,
+  omega_max]`` of the robot (the largest over a suite). The simulator then limits the change of
+  speed per step by the robot's accelerations, as for every planner.
+* **Reward** per step: the decrease of the distance to the goal [m] (``progress_weight`` x it),
+  minus ``time_penalty`` (default 0.01); plus ``goal_reward`` (10) on reaching the goal, minus
+  ``collision_penalty`` (10) on a collision.
+* **Termination**: ``terminated`` at the goal (within the robot's ``goal_tolerance``) or at a
+  collision (with a static obstacle, a wall or a moving obstacle); ``truncated`` at the time
+  limit (the scenario's ``time_limit`` or ``time_limit``) when neither happened.
+* **Seeding**: ``reset(seed=...)`` seeds the choice of scenario (and the random worlds), and
+  the sensor's noise when the scenario's perception mode has noise, as ``simulate(...,
+  seed=...)`` does; with the default exact perception the simulation has no randomness.
+* ``info``: ``t`` [s], ``status`` (running, reached, collision, timeout), ``scenario`` (name),
+  ``min_clearance_m``, ``collision_with``, and ``result`` (the :class:`RunResult` at the end).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+from anyplan.agents.policy import ObservationEncoder
+from anyplan.simulation.simulator import SimConfig, Simulation
+from anyplan.world.robot import Command
+from anyplan.world.scenario import Scenario, load_scenario
+
+__all__ = ["NavEnv"]
+
+ScenarioLike = str | Path | Scenario
+
+#: Bound of every observation value (m, m/s, rad/s): far beyond any arena or speed.
+OBS_BOUND = 1.0e4
+
+
+class NavEnv(gymnasium.Env):
+    """See the module docstring.
+
+    Args:
+        scenario: A scenario, a list of them (a suite), or ``"random"``.
+        max_obstacles: Obstacle slots of the observation.
+        dt: Step [s], in (0, 0.05].
+        time_limit: Episode length [s]; None uses each scenario's ``time_limit``.
+        progress_weight, time_penalty, goal_reward, collision_penalty: Reward terms.
+        announce_motions: As :class:`~anyplan.simulation.SimConfig` (not in the vector; kept for
+            parity with the planners' runs).
+    """
+
+    metadata = {"render_modes": []}  # noqa: RUF012 - gymnasium's convention
+
+    def __init__(self, scenario: ScenarioLike | Sequence[ScenarioLike] = "paper-3", max_obstacles: int = 8,
+                 dt: float = 0.05, time_limit: float | None = None, progress_weight: float = 1.0,
+                 time_penalty: float = 0.01, goal_reward: float = 10.0, collision_penalty: float = 10.0,
+                 announce_motions: bool = True) -> None:
+        self.config = SimConfig(dt=dt, time_limit=time_limit, announce_motions=announce_motions)
+        self.random_worlds = isinstance(scenario, str) and scenario == "random"
+        if self.random_worlds:
+            from anyplan.experiments.generate import random_scenario
+
+            self._random_scenario = random_scenario
+            self.scenarios = [random_scenario(np.random.default_rng(0), n_moving=1)]
+        else:
+            items = [scenario] if isinstance(scenario, str | Path | Scenario) else list(scenario)
+            if not items:
+                raise ValueError("scenario: an empty suite")
+            self.scenarios = [s if isinstance(s, Scenario) else load_scenario(s) for s in items]
+        self.max_obstacles = max_obstacles
+        self.weights = (float(progress_weight), float(time_penalty), float(goal_reward),
+                        float(collision_penalty))
+        n = ObservationEncoder((0.0, 0.0), max_obstacles).size
+        self.observation_space = spaces.Box(-OBS_BOUND, OBS_BOUND, shape=(n,), dtype=np.float32)
+        v = max(s.robot.v_max for s in self.scenarios)
+        w = max(s.robot.omega_max for s in self.scenarios)
+        if self.random_worlds:  # every random world uses the paper's robot
+            v, w = self.scenarios[0].robot.v_max, self.scenarios[0].robot.omega_max
+        self.action_space = spaces.Box(np.array([-v, -w], dtype=np.float32),
+                                       np.array([v, w], dtype=np.float32), dtype=np.float32)
+        self.sim: Simulation | None = None
+        self._seed = 0
+        self.scenario: Scenario | None = None
+
+    def _distance(self) -> float:
+        s, g = self.sim.state, self.scenario.robot.goal  # type: ignore[union-attr]
+        return math.hypot(g[0] - s.x, g[1] - s.y)
+
+    def _obs(self) -> np.ndarray:
+        return self.encoder.encode(self.sim.observation())  # type: ignore[union-attr]
+
+    def _info(self) -> dict[str, Any]:
+        sim = self.sim
+        assert sim is not None
+        return {"t": sim.t, "status": sim.status, "scenario": self.scenario.name,  # type: ignore[union-attr]
+                "min_clearance_m": float(sim.min_clearance_m), "collision_with": sim.collision_with}
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        """Start an episode; ``options={"scenario": i}`` picks the suite's i-th scenario."""
+        super().reset(seed=seed)
+        if seed is not None:
+            self._seed = int(seed)
+        if self.random_worlds:
+            n = int(self.np_random.integers(1, 7))
+            self.scenario = self._random_scenario(self.np_random, n_moving=n)
+        elif options and "scenario" in options:
+            self.scenario = self.scenarios[int(options["scenario"])]
+        else:
+            self.scenario = self.scenarios[int(self.np_random.integers(len(self.scenarios)))]
+        self.sim = Simulation(self.scenario, self.config, seed=self._seed)
+        if self.sim.done:
+            raise ValueError(f"scenario {self.scenario.name}: nothing to simulate "
+                             f"({'goal proven unreachable' if self.sim.unreachable else 'start at the goal'})")
+        self.encoder = ObservationEncoder(self.scenario.robot.goal, self.max_obstacles)
+        self._dist = self._distance()
+        return self._obs(), self._info()
+
+    def step(self, action):
+        """Apply ``action`` = (v [m/s], omega [rad/s]) for one step."""
+        if self.sim is None or self.sim.done:
+            raise RuntimeError("call reset() first: the episode is over")
+        a = np.asarray(action, dtype=float).reshape(-1)
+        a = np.clip(a, self.action_space.low, self.action_space.high)
+        self.sim.step(Command(float(a[0]), float(a[1])))
+        dist = self._distance()
+        wp, wt, wg, wc = self.weights
+        reward = wp * (self._dist - dist) - wt
+        self._dist = dist
+        collided = self.sim.collision_with is not None
+        terminated = collided or self.sim.reached
+        if self.sim.reached and not collided:
+            reward += wg
+        if collided:
+            reward -= wc
+        truncated = self.sim.done and not terminated
+        info = self._info()
+        if terminated or truncated:
+            info["result"] = self.sim.result("gym", self._seed)
+        return self._obs(), float(reward), bool(terminated), bool(truncated), info
