@@ -89,3 +89,12 @@ def test_run_as_mcap_reads_back_equal_to_the_run(tmp_path, capsys):
     # Log times never go back.
     times = sorted(lt for v in msgs.values() for lt, _ in v)
     assert times[-1] == round(traj[-1, 0] * 1e9)
+
+
+def test_bad_mcap_target_exits_2_before_the_run(tmp_path, capsys):
+    out = tmp_path / "o"
+    assert main(["run", "paper-1", "--planner", "straight", "--out", str(out),
+                 "--mcap", str(tmp_path / "nowhere" / "x.mcap")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--mcap" in err and "does not exist" in err
+    assert not (out / "result.json").exists()

@@ -92,6 +92,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         from anyplan.experiments.mcap_log import check_target as check_mcap
 
         check_mcap(args.mcap)
+        checks.writable_file(args.mcap, "run: --mcap", (".mcap",), make_parent=False)
     agent = make_agent(args.planner, **config)
     _prepare_kernels(getattr(agent, "kernel_parts", ()))
     result = simulate(scenario, agent, seed=args.seed, config=cfg)
