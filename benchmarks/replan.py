@@ -20,7 +20,7 @@ printed beside ours; ratios are ours / paper and cold / warm from this same run.
 
 Usage::
 
-    python benchmarks/replan.py [--seeds 10] [--random 12] [--configs warm,cold,dovs] [--jobs 2]
+    python benchmarks/replan.py [--seeds 10] [--random 12] [--gap 0] [--configs warm,cold,dovs] [--jobs 2]
 """
 
 from __future__ import annotations
@@ -42,14 +42,20 @@ PAPER = {  # the paper's Tables 2 and 3: (path length m, path generation time s,
 
 
 def _agent(config: str) -> Any:
-    """``warm``, ``cold`` or ``dovs``, optionally with options: ``cold:iteration_budget_s=0.002``."""
+    """``warm``, ``cold`` or ``dovs``, optionally with options: ``cold:iteration_budget_s=0.002``
+    (``True``/``False`` and ``()`` are read as such: ``cold:safety=False;wait_delays_s=()``)."""
     from anyplan.agents import make_agent
 
     name, _, opts = config.partition(":")
     kw: dict[str, Any] = {}
     for item in filter(None, opts.split(";")):
         k, _, v = item.partition("=")
-        kw[k] = float(v) if v.replace(".", "", 1).replace("e-", "", 1).isdigit() else v
+        if v in ("True", "False"):
+            kw[k] = v == "True"
+        elif v == "()":
+            kw[k] = ()
+        else:
+            kw[k] = float(v) if v.replace(".", "", 1).replace("e-", "", 1).isdigit() else v
     if name == "warm":
         return make_agent("seq-bitstar", warm_start=True, **kw)
     if name == "cold":
@@ -63,7 +69,7 @@ def _scenario(key: str) -> Any:
     from anyplan.experiments.generate import random_scenario
     from anyplan.world import load_scenario
 
-    if key.startswith("paper-"):
+    if key.startswith("paper-") or key == "gap-walker":
         return load_scenario(key)
     _, seed, n = key.split(":")
     return random_scenario(np.random.default_rng(int(seed)), n_moving=int(n))
@@ -137,6 +143,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=int, default=10, help="seeds per paper scenario (default 10)")
     ap.add_argument("--random", type=int, default=12,
                     help="random scenarios per number of moving obstacles 1..6 (default 12)")
+    ap.add_argument("--gap", type=int, default=0,
+                    help="seeds on the built-in gap-walker scenario (issue 10; default 0)")
     ap.add_argument("--configs", default="warm,cold,dovs",
                     help="comma list of warm, cold, dovs, each optionally with agent options "
                     "after a colon, separated by semicolons (e.g. 'cold:iteration_budget_s=0.002')")
@@ -149,6 +157,7 @@ def main(argv: list[str] | None = None) -> int:
             jobs += [(f"paper-{n}", c, s) for s in range(args.seeds)]
         for n in range(1, 7):
             jobs += [(f"random:{9000 + 100 * n + i}:{n}", c, i) for i in range(args.random)]
+        jobs += [("gap-walker", c, s) for s in range(args.gap)]
     t0 = time.perf_counter()
     rows: list[dict[str, Any]] = []
     with ProcessPoolExecutor(max_workers=args.jobs, initializer=_warm_up) as pool:
@@ -169,6 +178,7 @@ def main(argv: list[str] | None = None) -> int:
     groups += [(f"random, {n} moving", lambda r, n=n: r["key"].startswith("random") and r["n_moving"] == n)
                for n in range(1, 7)]
     groups += [("random, all", lambda r: r["key"].startswith("random"))]
+    groups += [("gap-walker", lambda r: r["key"] == "gap-walker")]
     summary: dict[tuple[str, str], dict[str, Any]] = {}
     for name, pred in groups:
         for c in configs:

@@ -14,6 +14,16 @@ reference then starts slightly behind the robot's pose; Kanayama's law absorbs t
 fixed ``planning_delay`` in seconds makes runs reproducible for a seed, independent of the
 machine.
 
+**The safety invariant** (:mod:`anyplan.agents.safety`) wraps what the agent executes: a new
+motion is only taken up when it is predicted collision-free until it ends at rest, or when the
+robot can still brake to rest on it without a predicted collision after the time it needs to act
+again (check period + planning delay). Otherwise the agent keeps its current motion if that one
+still passes, or takes the fallback (brake, hold, turn away, back off) with the largest predicted
+clearance; fallbacks are listed in ``stats.extra["fallbacks"]`` and every decision in
+``stats.extra["safety"]``. Algorithm 1 itself is unchanged; ``safety=False`` turns the
+invariant off (the paper's behaviour: a motion with a predicted collision is taken when no
+collision-free one is found).
+
 Moving obstacles are known through observations only; their motion is predicted with a constant
 twist (:class:`~anyplan.prediction.ConstantTwistPredictor`), which is exact for the paper's
 obstacles. With ``robot.sensing_range`` set, obstacles appear when they come into range and the
@@ -29,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
+from anyplan.agents.safety import HoldSegment, SafetyConfig, SafetyGuard
 from anyplan.agents.warmup import warm_up_kernels
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
 from anyplan.geometry.shapes import Shape
@@ -36,31 +47,11 @@ from anyplan.planning.sequential import SequentialBITStar, SequentialConfig, Seq
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
 from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.motion import brake_to_rest, continue_from, plan_motion
-from anyplan.trajectory.trajectory import BrakeSegment, Segment, Trajectory
+from anyplan.trajectory.trajectory import BrakeSegment, Trajectory
 from anyplan.world.robot import Command, RobotState
 from anyplan.world.scenario import Scenario
 
 __all__ = ["SequentialBITStarAgent", "HoldSegment"]
-
-
-class HoldSegment(Segment):
-    """Standing still at (x, y, theta) from ``t0`` to ``t1`` [s]."""
-
-    kind = "hold"
-
-    def __init__(self, x: float, y: float, theta: float, t0: float, t1: float) -> None:
-        self.x, self.y, self.theta = float(x), float(y), float(theta)
-        self.t0, self.t1 = float(t0), float(t1)
-        self.max_speed = 0.0
-        self.length = 0.0
-
-    def sample(self, t: np.ndarray) -> tuple[np.ndarray, ...]:  # type: ignore[override]
-        t = np.asarray(t, dtype=float)
-        z = np.zeros(t.shape)
-        return np.full(t.shape, self.x), np.full(t.shape, self.y), np.full(t.shape, self.theta), z, z
-
-    def path_points(self, step: float) -> np.ndarray:
-        return np.array([[self.x, self.y]])
 
 
 #: Longest wait [s] between two replannings after repeated failures.
@@ -82,6 +73,8 @@ class SequentialBITStarAgent(Agent):
             by which each new motion starts after the replanning decision.
         grid_step: Grid spacing [m] of the velocity profile and of the curve certification.
         gains: Kanayama gains.
+        safety: Apply the safety invariant (:mod:`anyplan.agents.safety`).
+        safety_config: Its settings (default: margin = the loop's ``margin``).
     """
 
     name = "seq-bitstar"
@@ -98,7 +91,8 @@ class SequentialBITStarAgent(Agent):
                  smooth_margin: float = 0.015, check_period_s: float = 0.2,
                  min_replan_interval_s: float = 0.5, urgent_s: float = 3.0,
                  planning_delay: str | float = "measured", grid_step: float = 0.05,
-                 gains: KanayamaGains | None = None, **loop_options: Any) -> None:
+                 gains: KanayamaGains | None = None, safety: bool = True,
+                 safety_config: SafetyConfig | None = None, **loop_options: Any) -> None:
         super().__init__()
         if config is None:
             config = SequentialConfig(**loop_options)
@@ -120,6 +114,9 @@ class SequentialBITStarAgent(Agent):
         self.planning_delay = planning_delay
         self.grid_step = float(grid_step)
         self.gains = gains or KanayamaGains()
+        self.safety = bool(safety)
+        self.safety_config = safety_config or SafetyConfig(margin=config.margin,
+                                                           recheck_margin=0.5 * config.margin)
 
     # --- lifecycle -------------------------------------------------------------------------------
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
@@ -143,9 +140,14 @@ class SequentialBITStarAgent(Agent):
         self._seen: set[str] = set()
         self._requested: str | None = None
         self.tracking = TrackingLog()
+        self.guard = SafetyGuard(self.spec, self.obstacles, self.safety_config)
+        self.executed: list[tuple[float, Trajectory]] = []  # (switch time [s], trajectory)
+        self._fallback_active = False
+        self._commit_s = self.check_period_s + 0.1
         ex = self.stats.extra
         ex.update({"statuses": {}, "iterations": [], "late_plans": 0, "plan_time_s": [],
-                   "motion_time_s": [], "replan_times_s": [], "waits": 0})
+                   "motion_time_s": [], "replan_times_s": [], "waits": 0,
+                   "fallbacks": self.guard.fallbacks, "safety_time_s": []})
 
     # --- motions ---------------------------------------------------------------------------------
     def _motion_fn(self, state: RobotState, t_start: float):  # noqa: ANN202
@@ -224,6 +226,8 @@ class SequentialBITStarAgent(Agent):
             # BIT*'s cost against solve time in the first planning (OMPL's progress property).
             ex["progress"] = [[float(a), float(b)] for a, b in res.history]
         if res.motion is None:
+            if self.safety:
+                self._guarded(obs, None, t_ready, d, preds, res)
             # Keep the current reference (or stay put); try again after a back-off that doubles
             # with each consecutive failure up to MAX_BACKOFF_S, so that a goal no planning
             # reaches costs a bounded fraction of real time.
@@ -245,10 +249,37 @@ class SequentialBITStarAgent(Agent):
             shapes = [v.shape for v in res.virtual_obstacles]
             motion = self._motion_fn(state, t_switch)(res.path, shapes, res.delay_s)
             st.planning_times_s[-1] = wall + (time.perf_counter() - w1)
-        st.plans.append({"t": t, "t_start": t_switch, "path": np.asarray(res.path).tolist(),
-                         "status": res.status, "virtual_obstacles": len(res.virtual_obstacles),
-                         "delay_s": res.delay_s})
+        if self.safety:
+            self._guarded(obs, motion, t_switch, t_switch - t, preds, res)
+            return
+        self._record_plan(t, t_switch, res)
         self.pending = (t_switch, motion)
+
+    def _record_plan(self, t: float, t_switch: float, res: SequentialResult) -> None:
+        self.stats.plans.append({"t": t, "t_start": t_switch, "path": np.asarray(res.path).tolist(),
+                                 "status": res.status, "virtual_obstacles": len(res.virtual_obstacles),
+                                 "delay_s": res.delay_s})
+
+    def _guarded(self, obs: Observation, motion: Trajectory | None, t_switch: float, delay: float,
+                 preds: list[PredictedObstacle], res: SequentialResult) -> None:
+        """Let the safety guard decide what the robot executes from ``t_switch`` [s]."""
+        w0 = time.perf_counter()
+        # Before the agent can act again: one check period, then a replanning's delay.
+        self._commit_s = self.check_period_s + delay
+        current = self.trajectory
+        state = self._state_at(obs, t_switch)
+        dec = self.guard.decide(t_switch, motion, current, state, preds, self._commit_s)
+        wall = time.perf_counter() - w0
+        self.stats.planning_times_s[-1] += wall  # the decision is part of the planning call
+        ex = self.stats.extra
+        ex["safety_time_s"].append(wall)
+        ex["safety"] = self.guard.log()
+        if dec.kind == "keep":
+            return
+        if dec.kind == "motion":
+            self._record_plan(obs.t, t_switch, res)
+        self._fallback_active = dec.kind not in ("motion", "keep")
+        self.pending = (t_switch, dec.trajectory)
 
     # --- control ---------------------------------------------------------------------------------
     def act(self, obs: Observation) -> Command:
@@ -259,8 +290,7 @@ class SequentialBITStarAgent(Agent):
         t = obs.t
         preds = self.predictor.predict(obs.obstacles)
         if self.pending is not None and t >= self.pending[0] - 1e-9:
-            self.trajectory = self.pending[1]
-            self.pending = None
+            self._switch()
         if self.trajectory is None and self.pending is None:
             # The first plan: the robot stays at rest while it is computed.
             if t < self._retry_at - 1e-9:
@@ -269,7 +299,7 @@ class SequentialBITStarAgent(Agent):
             self._last_check = t
             self._seen = {p.name for p in preds}
             if self.pending is not None and t >= self.pending[0] - 1e-9:
-                self.trajectory, self.pending = self.pending[1], None
+                self._switch()
         elif (self.trajectory is not None and self.pending is None
               and (t - self._last_check >= self.check_period_s - 1e-9
                    or self._requested is not None)):
@@ -284,6 +314,12 @@ class SequentialBITStarAgent(Agent):
     def request_replan(self, reason: str) -> None:
         """Replan at the next step (e.g. an obstacle left its predicted tube)."""
         self._requested = reason
+
+    def _switch(self) -> None:
+        assert self.pending is not None
+        self.trajectory = self.pending[1]
+        self.executed.append(self.pending)
+        self.pending = None
 
     def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
         t = obs.t
@@ -302,10 +338,20 @@ class SequentialBITStarAgent(Agent):
         if t >= traj.t_end and math.hypot(obs.robot.x - self.spec.goal[0],
                                           obs.robot.y - self.spec.goal[1]) <= self.spec.goal_tolerance:
             return
+        if self.safety and self._fallback_active:
+            # Parked by a fallback: try again to get going.
+            if (t - self._last_replan >= self.min_replan_interval_s - 1e-9
+                    and t >= self._retry_at - 1e-9):
+                self._replan(obs, preds, "after a fallback")
+            return
         hit = first_collision(traj, preds, self.spec.radius, t_from=t,
                               t_until=max(traj.t_end, t) + 1.0, margin=0.5 * self.config.margin,
                               sample_dt=self.config.prediction_dt)
         if hit is None:
+            return
+        if self.safety and not self.guard.still_safe(traj, preds, t, self._commit_s):
+            self._replan(obs, preds, f"safety: collision with {hit.obstacle} predicted at "
+                                     f"{hit.t:.2f} s, the robot must act now")
             return
         urgent = hit.t - t < self.urgent_s
         if not urgent and not new and t - self._last_replan < self.min_replan_interval_s:

@@ -141,13 +141,18 @@ def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
     pt = result.planning_times_s
     lines = [
         f"{result.scenario} / {result.planner} / seed {result.seed}: {result.status}"
-        + (f" (hit {result.collision_with} at t = {result.collision_time_s:.2f} s)"
+        + (f" (hit {result.collision_with} at t = {result.collision_time_s:.2f} s, "
+           f"{'robot-caused' if result.collision_robot_caused else 'not robot-caused'})"
            if result.collision else ""),
-        f"  time to goal   {result.time_to_goal_s:.2f} s" if result.time_to_goal_s is not None
-        else "  time to goal   -",
+        (f"  time to goal   {result.time_to_goal_s:.2f} s" if result.time_to_goal_s is not None
+         else "  time to goal   -")
+        + (f" ({result.time_over_lower_bound:.3f} x lower bound {result.time_lower_bound_s:.2f} s)"
+           if result.time_over_lower_bound is not None else ""),
         f"  path length    {result.path_length_m:.3f} m",
         f"  min clearance  {result.min_clearance_m:.3f} m",
         f"  planning       {len(pt)} calls, {sum(pt):.3f} s total, {result.replans} replans",
+        *([f"  fallbacks      {len(result.extra['fallbacks'])}"]
+          if result.extra.get("fallbacks") else []),
         f"  wrote          {out / 'result.json'}",
     ]
     return "\n".join(lines)

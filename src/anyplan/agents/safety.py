@@ -1,0 +1,383 @@
+"""The safety invariant for agents that plan among moving obstacles, and its fallbacks.
+
+**The rule.** The robot only starts (switches to) a motion ``M`` at time ``t_s`` when either
+
+* ``M`` is predicted collision-free from ``t_s`` until it ends at rest ("free to rest"), or
+* ``M`` can still be abandoned: the *escape* "follow ``M`` until ``t_s + commit_s``, then brake to
+  rest at a_max and alpha_max" (:func:`anyplan.trajectory.motion.brake_to_rest`) is predicted
+  collision-free until the robot is at rest, and its braking path clears the static obstacles
+  ("stoppable"). ``commit_s`` is the time the agent needs before it can act again (its check
+  period plus its planning delay), so M's first predicted collision lies beyond the time the
+  robot needs to come to rest on M.
+
+Predictions use the certified predictor (:func:`anyplan.prediction.collision.first_collision`),
+with the robot's radius plus ``margin`` against each predicted disc (whatever the predictor
+gives). A contact that can only happen once the robot is at rest is not one the robot causes.
+
+**Fallbacks.** When the proposed motion breaks the rule (or there is none) and the current motion
+cannot be kept either (:meth:`SafetyGuard.still_safe`), the guard picks one of
+
+* ``brake``: brake to rest on the current path and stay (``hold`` when already at rest);
+* ``turn_away``: brake, turn in place and move ``d`` sideways, perpendicular to the threat;
+* ``back_off``: brake, turn in place and move ``d`` straight away from the threat,
+
+(``d`` in ``config.offsets_m``, keeping the static clearance) by **predicted clearance over a
+horizon**: the candidates whose moving part is predicted collision-free come first, and among them
+the one with the largest certified minimum distance to every predicted obstacle over
+``[t_s, t_s + horizon_s]`` (:func:`anyplan.geometry.moving.closest_approach`). "The motion whose
+collision is latest" is never chosen while a safe option exists.
+
+API (shared by ``seq-bitstar`` and any other agent)::
+
+    guard = SafetyGuard(spec, static_obstacles, SafetyConfig())    # once per run
+    # the planner proposes ``motion`` (a Trajectory, or None) that would start at t_switch from
+    # ``state`` (the robot's state then, on its current reference); ``current`` is what the
+    # robot executes now (None before the first plan):
+    d = guard.decide(t_switch, motion, current, state, predictions, commit_s)
+    # d.kind: "motion" (start it), "keep" (keep ``current``) or a fallback kind;
+    # execute d.trajectory from t_switch (d.trajectory is current when d.kind == "keep").
+    guard.still_safe(current, predictions, t, commit_s)    # periodic re-check of the current motion
+    result_extra["fallbacks"] = guard.fallbacks            # [{"t", "kind", "predicted_clearance_m"}]
+    guard.decisions                                        # every Decision, with its trajectory
+
+Every decision is logged (:attr:`SafetyGuard.decisions`) with what it was checked against, so a
+test can re-predict it independently; :meth:`SafetyGuard.log` is its JSON form.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from anyplan.geometry.collision import ObstacleSet
+from anyplan.geometry.moving import closest_approach
+from anyplan.prediction.base import PredictedObstacle
+from anyplan.prediction.collision import first_collision
+from anyplan.trajectory.motion import brake_to_rest, polyline_trajectory
+from anyplan.trajectory.trajectory import BrakeSegment, Segment, Trajectory
+from anyplan.world.robot import RobotSpec, RobotState
+
+__all__ = ["SafetyConfig", "Decision", "Escape", "SafetyGuard", "HoldSegment", "escape_motion",
+           "FALLBACK_KINDS"]
+
+#: The fallback kinds, in order of preference when their clearances tie.
+FALLBACK_KINDS = ("hold", "brake", "turn_away", "back_off")
+_EPS_V = 1e-6  # [m/s] below this the robot counts as at rest
+
+
+class HoldSegment(Segment):
+    """Standing still at (x, y, theta) from ``t0`` to ``t1`` [s]."""
+
+    kind = "hold"
+
+    def __init__(self, x: float, y: float, theta: float, t0: float, t1: float) -> None:
+        self.x, self.y, self.theta = float(x), float(y), float(theta)
+        self.t0, self.t1 = float(t0), float(t1)
+        self.max_speed = 0.0
+        self.length = 0.0
+
+    def sample(self, t: np.ndarray) -> tuple[np.ndarray, ...]:  # type: ignore[override]
+        t = np.asarray(t, dtype=float)
+        z = np.zeros(t.shape)
+        return np.full(t.shape, self.x), np.full(t.shape, self.y), np.full(t.shape, self.theta), z, z
+
+    def path_points(self, step: float) -> np.ndarray:
+        return np.array([[self.x, self.y]])
+
+
+@dataclass(frozen=True)
+class SafetyConfig:
+    """Settings of the safety guard (times in s, lengths in m).
+
+    Attributes:
+        margin: Extra clearance [m] between the robot's reference and each predicted disc in the
+            decisions (absorbs the tracking error).
+        recheck_margin: Margin [m] of :meth:`SafetyGuard.still_safe` (smaller: hysteresis).
+        horizon_s: Horizon [s] of the predicted clearance that ranks the fallbacks.
+        offsets_m: Distances [m] tried by ``turn_away`` and ``back_off``.
+        sample_dt: Resampling step [s] of the certified predictor (None: on the motion itself).
+        tol: Time accuracy [s] of the clearance search.
+    """
+
+    margin: float = 0.05
+    recheck_margin: float = 0.025
+    horizon_s: float = 5.0
+    offsets_m: tuple[float, ...] = (0.6, 1.2)
+    sample_dt: float | None = 0.02
+    tol: float = 1e-3
+
+    def __post_init__(self) -> None:
+        if self.margin < 0.0 or self.recheck_margin < 0.0:
+            raise ValueError("margin, recheck_margin: must be >= 0")
+        if not self.horizon_s > 0.0:
+            raise ValueError(f"horizon_s: must be > 0, got {self.horizon_s}")
+        if any(d <= 0.0 for d in self.offsets_m):
+            raise ValueError("offsets_m: distances must be > 0")
+
+
+class Escape:
+    """Follow ``motion`` until ``t_commit`` [s], then brake to rest (a TimedMotion).
+
+    Attributes:
+        t_rest: Time [s] the robot is at rest.
+        static_free: The braking path clears the static obstacles.
+    """
+
+    def __init__(self, motion: Any, t_commit: float, spec: RobotSpec, obstacles: ObstacleSet,
+                 radius: float) -> None:
+        self.motion = motion
+        self.t_commit = float(min(max(t_commit, motion.t_start), motion.t_end))
+        st = RobotState(*motion.state(self.t_commit))
+        segs, t_rest, _, free = brake_to_rest(st, spec, obstacles, radius, self.t_commit)
+        self.brake: BrakeSegment | None = segs[0] if segs else None  # type: ignore[assignment]
+        self.t_rest = float(t_rest)
+        self.static_free = bool(free)
+        self.t_start = float(motion.t_start)
+        self.t_end = self.t_rest
+        self.max_speed = float(motion.max_speed)
+
+    def positions(self, t: np.ndarray) -> np.ndarray:
+        """Positions (N, 2) [m] at absolute times ``t`` [s]."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        p = self.motion.positions(np.minimum(t, self.t_commit))
+        if self.brake is not None:
+            late = t > self.t_commit
+            if late.any():
+                x, y, _, _, _ = self.brake.sample(np.minimum(t[late], self.brake.t1))
+                p[late, 0], p[late, 1] = x, y
+        return p
+
+
+def escape_motion(motion: Any, t_commit: float, spec: RobotSpec, obstacles: ObstacleSet,
+                  radius: float | None = None) -> Escape:
+    """The escape of ``motion`` braking from ``t_commit`` [s] (see :class:`Escape`)."""
+    return Escape(motion, t_commit, spec, obstacles, spec.radius if radius is None else radius)
+
+
+@dataclass
+class Decision:
+    """One decision of the guard.
+
+    Attributes:
+        t: Time [s] the chosen trajectory starts.
+        kind: ``"motion"``, ``"keep"`` or a fallback kind (:data:`FALLBACK_KINDS`).
+        trajectory: What the robot executes from ``t``.
+        safe: True when ``trajectory`` satisfies the rule from ``t`` (free to rest, or stoppable);
+            for a fallback, when its moving part is predicted collision-free.
+        rule: ``"free_to_rest"``, ``"stoppable"``, ``"fallback"`` or ``"unsafe"``.
+        t_commit: For ``stoppable``: the time [s] the escape starts braking.
+        t_rest: Time [s] the robot is at rest on the checked motion (escape or fallback).
+        first_collision_s: First predicted collision [s] of the proposed motion (None if free).
+        predicted_clearance_m: For a fallback: its predicted clearance [m] over the horizon.
+        candidates: For a fallback: ``(kind, moving_free, clearance [m])`` of every candidate.
+        reason: Why a fallback was needed.
+    """
+
+    t: float
+    kind: str
+    trajectory: Any
+    safe: bool
+    rule: str
+    t_commit: float | None = None
+    t_rest: float | None = None
+    first_collision_s: float | None = None
+    predicted_clearance_m: float | None = None
+    candidates: list[tuple[str, bool, float]] = field(default_factory=list)
+    reason: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form (without the trajectory)."""
+        out: dict[str, Any] = {"t": self.t, "kind": self.kind, "safe": self.safe, "rule": self.rule}
+        for k in ("t_commit", "t_rest", "first_collision_s", "predicted_clearance_m"):
+            v = getattr(self, k)
+            if v is not None:
+                out[k] = float(v) if math.isfinite(v) else None
+        if self.reason:
+            out["reason"] = self.reason
+        return out
+
+
+class SafetyGuard:
+    """Checks proposed motions against the rule and chooses fallbacks (see the module docstring).
+
+    Args:
+        spec: The robot.
+        obstacles: Static obstacles with walls.
+        config: Settings.
+    """
+
+    def __init__(self, spec: RobotSpec, obstacles: ObstacleSet,
+                 config: SafetyConfig | None = None) -> None:
+        self.spec = spec
+        self.obstacles = obstacles
+        self.config = config or SafetyConfig()
+        self.decisions: list[Decision] = []
+        self.fallbacks: list[dict[str, Any]] = []
+
+    # --- checks ------------------------------------------------------------------------------
+    def _hit(self, motion: Any, preds: Sequence[PredictedObstacle], t0: float, t1: float,
+             margin: float) -> Any:
+        if t1 <= t0 or not preds:
+            return None
+        return first_collision(motion, preds, self.spec.radius, t_from=t0, t_until=t1,
+                               margin=margin, sample_dt=self.config.sample_dt)
+
+    def check(self, motion: Any, preds: Sequence[PredictedObstacle], t: float, commit_s: float,
+              margin: float | None = None) -> tuple[str, float | None, float | None, float | None]:
+        """Whether ``motion`` may be started (or kept) at ``t`` [s].
+
+        Returns:
+            ``(rule, t_commit, t_rest, first_collision_s)`` with rule ``"free_to_rest"``,
+            ``"stoppable"`` or ``"unsafe"``.
+        """
+        m = self.config.margin if margin is None else margin
+        t_end = max(float(motion.t_end), t)
+        hit = self._hit(motion, preds, t, t_end, m)
+        if hit is None:
+            return "free_to_rest", None, t_end, None
+        esc = Escape(motion, t + commit_s, self.spec, self.obstacles, self.spec.radius)
+        if esc.static_free and self._hit(esc, preds, t, esc.t_rest, m) is None:
+            return "stoppable", esc.t_commit, esc.t_rest, hit.t
+        return "unsafe", esc.t_commit, esc.t_rest, hit.t
+
+    def still_safe(self, current: Any, preds: Sequence[PredictedObstacle], t: float,
+                   commit_s: float) -> bool:
+        """True if the current motion still satisfies the rule from ``t`` [s] (with the
+        re-check margin)."""
+        if current is None:
+            return True
+        return self.check(current, preds, t, commit_s, self.config.recheck_margin)[0] != "unsafe"
+
+    # --- decisions ---------------------------------------------------------------------------
+    def decide(self, t: float, motion: Any, current: Any, state: RobotState,
+               preds: Sequence[PredictedObstacle], commit_s: float) -> Decision:
+        """Start ``motion``, keep ``current``, or fall back (see the module docstring).
+
+        Args:
+            t: Time [s] at which the chosen trajectory starts.
+            motion: The proposed motion (a Trajectory from ``state`` at ``t``), or None.
+            current: What the robot executes now, or None (at rest before the first plan).
+            state: The robot's state at ``t`` (on ``current``, or its own).
+            preds: Predicted moving obstacles.
+            commit_s: Time [s] before the agent can act again.
+        """
+        reason = "no motion proposed"
+        if motion is not None:
+            rule, tc, tr, fc = self.check(motion, preds, t, commit_s)
+            if rule != "unsafe":
+                return self._log(Decision(t, "motion", motion, True, rule, tc, tr, fc))
+            reason = f"proposed motion: collision predicted at {fc:.2f} s, cannot stop before it"
+        if current is not None and t < current.t_end + 1e-9:
+            rule, tc, tr, fc = self.check(current, preds, t, commit_s)
+            if rule != "unsafe":
+                return self._log(Decision(t, "keep", current, True, rule, tc, tr, fc))
+        return self._log(self.fallback(t, state, preds, reason))
+
+    def _log(self, d: Decision) -> Decision:
+        self.decisions.append(d)
+        if d.kind in FALLBACK_KINDS:
+            self.fallbacks.append({"t": float(d.t), "kind": d.kind,
+                                   "predicted_clearance_m": _finite(d.predicted_clearance_m)})
+        return d
+
+    def log(self) -> list[dict[str, Any]]:
+        """Every decision in JSON form."""
+        return [d.to_dict() for d in self.decisions]
+
+    # --- fallbacks ---------------------------------------------------------------------------
+    def clearance(self, motion: Any, preds: Sequence[PredictedObstacle], t0: float,
+                  t1: float) -> float:
+        """Certified minimum distance [m] between the robot's disc on ``motion`` and every
+        predicted disc over [t0, t1] [s] (inf without predictions; negative when they overlap).
+        A disc whose radius grows with the horizon counts with its largest radius (a lower
+        bound on the clearance)."""
+        best = math.inf
+        r = self.spec.radius
+        p0 = motion.positions(np.array([t0]))[0]
+        for o in preds:
+            q0 = o.positions(np.array([t0]))[0]
+            speed = float(motion.max_speed) + float(o.max_speed)
+            ro = _max_radius(o)
+            lb = math.hypot(*(p0 - q0)) - speed * (t1 - t0) - r - ro
+            if lb >= best:
+                continue  # cannot come closer than the best so far
+            _, d = closest_approach(motion.positions, o.positions, speed, t0, t1, tol=self.config.tol)
+            best = min(best, d - r - ro)
+        return best
+
+    def candidates(self, t: float, state: RobotState,
+                   preds: Sequence[PredictedObstacle]) -> list[tuple[str, Trajectory, float]]:
+        """The fallback trajectories from ``state`` at ``t`` [s], as ``(kind, trajectory,
+        time at rest [s])``: brake (or hold), then turn_away and back_off targets that keep the
+        static clearance."""
+        spec, cfg = self.spec, self.config
+        h = t + cfg.horizon_s
+        segs, t_rest, rest, _ = brake_to_rest(state, spec, self.obstacles, spec.radius, t)
+        moving = abs(state.v) > _EPS_V
+        if abs(rest.omega) > 1e-9:
+            stop = BrakeSegment(rest.x, rest.y, rest.theta, 0.0, rest.omega, spec.a_max,
+                                spec.alpha_max, t_rest)
+            segs.append(stop)
+            t_rest = stop.t1
+            x, y, th, _, _ = stop.sample(np.array([t_rest]))
+            rest = RobotState(float(x[0]), float(y[0]), float(th[0]), 0.0, 0.0)
+        hold = Trajectory(segs + [HoldSegment(rest.x, rest.y, rest.theta, t_rest, max(h, t_rest))],
+                          kind="brake" if moving else "hold")
+        out: list[tuple[str, Trajectory, float]] = [("brake" if moving else "hold", hold, t_rest)]
+        if not preds:
+            return out
+        # The threat: the predicted obstacle that comes nearest to the robot braking in place.
+        p_rest = np.array([rest.x, rest.y])
+        ts = np.linspace(t, h, 41)
+        pr = hold.positions(ts)
+        best, u = math.inf, None
+        for o in preds:
+            d = np.hypot(*(pr - o.positions(ts)).T) - _max_radius(o)
+            k = int(np.argmin(d))
+            if d[k] < best:
+                best = float(d[k])
+                u = o.positions(ts[k:k + 1])[0] - p_rest
+        if u is None or math.hypot(*u) < 1e-9:
+            return out
+        u = u / math.hypot(*u)
+        perp = np.array([-u[1], u[0]])
+        radius = spec.radius + cfg.margin
+        for kind, dirs in (("turn_away", (perp, -perp)), ("back_off", (-u,))):
+            for dvec in dirs:
+                for dist in cfg.offsets_m:
+                    target = p_rest + dist * dvec
+                    if not self.obstacles.segment_free(p_rest, target, radius):
+                        continue
+                    tr = polyline_trajectory(np.array([p_rest, target]), spec, state, t,
+                                             self.obstacles, radius)
+                    if tr.certified_free:
+                        out.append((kind, tr, float(tr.t_end)))
+        return out
+
+    def fallback(self, t: float, state: RobotState, preds: Sequence[PredictedObstacle],
+                 reason: str = "") -> Decision:
+        """The best fallback from ``state`` at ``t`` [s] (not logged; :meth:`decide` logs)."""
+        h = t + self.config.horizon_s
+        scored = []
+        for i, (kind, tr, t_rest) in enumerate(self.candidates(t, state, preds)):
+            moving_free = self._hit(tr, preds, t, t_rest, self.config.margin) is None
+            clear = self.clearance(tr, preds, t, max(h, t_rest))
+            scored.append((moving_free, clear, -FALLBACK_KINDS.index(kind), -i, kind, tr, t_rest))
+        best = max(scored, key=lambda s: s[:4])
+        cands = [(s[4], bool(s[0]), float(s[1])) for s in scored]
+        return Decision(t, best[4], best[5], bool(best[0]), "fallback", None, best[6], None,
+                        float(best[1]), cands, reason)
+
+
+def _max_radius(o: Any) -> float:
+    return float(getattr(o, "max_radius", o.radius))
+
+
+def _finite(x: float | None) -> float | None:
+    if x is None:
+        return None
+    return float(x) if math.isfinite(x) else None
