@@ -85,7 +85,7 @@ class SequentialBITStarAgent(Agent):
     #: wall-clock cap far above any planning time: the run no longer depends on the machine.
     deterministic_settings = {"planning_delay": 0.1, "batches_per_plan": 2,  # noqa: RUF012
                               "max_time_s": 10.0}
-    wall_clock_extra = ("plan_time_s", "motion_time_s", "progress", "late_plans")
+    wall_clock_extra = ("plan_time_s", "motion_time_s", "progress", "late_plans", "safety_time_s")
 
     def __init__(self, config: SequentialConfig | None = None, *, plan_margin: float = 0.03,
                  smooth_margin: float = 0.015, check_period_s: float = 0.2,
