@@ -41,7 +41,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -50,6 +49,7 @@ from typing import Any
 import yaml
 
 from anyplan.errors import AnyplanError
+from anyplan.experiments import dynabarn
 from anyplan.world.scenario import Scenario, scenario_from_dict
 
 __all__ = ["JACKAL", "SHIFT", "ARENA", "START", "GOAL", "TIME_LIMIT", "N_WORLDS", "INDEX_FILE",
@@ -151,24 +151,7 @@ def parse_worlds(spec: str, n_worlds: int = N_WORLDS) -> list[int]:
     Raises:
         BARNError: a malformed item or an index outside 0..n_worlds-1.
     """
-    if spec.strip() == "all":
-        return list(range(n_worlds))
-    out: list[int] = []
-    for item in spec.split(","):
-        item = item.strip()
-        m = re.fullmatch(r"(\d+)(?:-(\d+))?", item)
-        if not m:
-            raise BARNError(f"--worlds: '{item}' is not an index or a range like 0-299")
-        a = int(m.group(1))
-        b = int(m.group(2)) if m.group(2) else a
-        if a > b:
-            raise BARNError(f"--worlds: empty range '{item}'")
-        for i in range(a, b + 1):
-            if not 0 <= i < n_worlds:
-                raise BARNError(f"--worlds: index {i} is outside 0-{n_worlds - 1}")
-            if i not in out:
-                out.append(i)
-    return out
+    return dynabarn.parse_worlds(spec, n_worlds, error=BARNError)
 
 
 def world_to_scenario(world: Mapping[str, Any], profile: Mapping[str, float] | None = None,

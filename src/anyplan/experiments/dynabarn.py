@@ -95,11 +95,12 @@ def load_worlds(path: str | Path) -> list[dict[str, Any]]:
     return data
 
 
-def parse_worlds(spec: str, n_worlds: int = 60) -> list[int]:
+def parse_worlds(spec: str, n_worlds: int = 60,
+                 error: type[AnyplanError] = DynaBARNError) -> list[int]:
     """World indices from ``"0-19"``, ``"3,5,40-42"`` or ``"all"``, in order, without repeats.
 
     Raises:
-        DynaBARNError: a malformed item or an index outside 0..n_worlds-1.
+        error (DynaBARNError by default): a malformed item or an index outside 0..n_worlds-1.
     """
     if spec.strip() == "all":
         return list(range(n_worlds))
@@ -108,14 +109,14 @@ def parse_worlds(spec: str, n_worlds: int = 60) -> list[int]:
         item = item.strip()
         m = re.fullmatch(r"(\d+)(?:-(\d+))?", item)
         if not m:
-            raise DynaBARNError(f"--worlds: '{item}' is not an index or a range like 0-19")
+            raise error(f"--worlds: '{item}' is not an index or a range like 0-{n_worlds - 1}")
         a = int(m.group(1))
         b = int(m.group(2)) if m.group(2) else a
         if a > b:
-            raise DynaBARNError(f"--worlds: empty range '{item}'")
+            raise error(f"--worlds: empty range '{item}'")
         for i in range(a, b + 1):
             if not 0 <= i < n_worlds:
-                raise DynaBARNError(f"--worlds: index {i} is outside 0-{n_worlds - 1}")
+                raise error(f"--worlds: index {i} is outside 0-{n_worlds - 1}")
             if i not in out:
                 out.append(i)
     return out
