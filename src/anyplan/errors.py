@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["AnyplanError", "ScenarioError", "UnknownNameError", "one_line", "shorten",
+__all__ = ["AnyplanError", "ScenarioError", "UnknownNameError", "UsageError", "one_line", "shorten",
            "MAX_MESSAGE_CHARS"]
 
 #: Longest error line printed by the command line [characters].
@@ -34,6 +34,10 @@ def shorten(value: object, limit: int = 40) -> str:
 
 class AnyplanError(Exception):
     """Base class of anyplan's input errors; its message is one line, fit for a user."""
+
+
+class UsageError(AnyplanError):
+    """Bad command-line input detected after parsing (exit code 2)."""
 
 
 class ScenarioError(AnyplanError, ValueError):

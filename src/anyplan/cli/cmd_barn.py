@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from anyplan.errors import UsageError
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``import-barn`` sub-command."""
@@ -37,8 +39,6 @@ def cmd_import_barn(args: argparse.Namespace) -> int:
     try:
         paths = convert(src, args.out, args.worlds, check_feasibility=not args.no_feasibility)
     except OSError as exc:
-        from anyplan.cli.main import UsageError
-
         raise UsageError(f"import-barn: --out {args.out}: cannot write ({exc.strerror})") from None
     if not paths:
         print("no worlds selected")

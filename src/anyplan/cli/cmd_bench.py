@@ -9,6 +9,7 @@ from pathlib import Path
 
 from anyplan.cli import checks
 from anyplan.cli.agent_options import add_agent_options
+from anyplan.errors import UsageError
 
 DESCRIPTION = """\
 Run every (scenario, planner, run) in parallel processes (or on a Dask cluster) and store each
@@ -127,8 +128,6 @@ def default_bench_planners() -> str:
 
 
 def _usage(msg: str) -> Exception:
-    from anyplan.cli.main import UsageError
-
     return UsageError(msg)
 
 
@@ -226,10 +225,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
 def cmd_bench_planning(args: argparse.Namespace) -> int:
     """Run the anytime planning benchmark and print its table."""
     from anyplan.experiments.db import ResultsDB
-    from anyplan.experiments.planning_bench import planning_table, run_planning_bench
+    from anyplan.experiments.planning_bench import (
+        OMPL_DEFAULT,
+        ompl_available,
+        planning_table,
+        run_planning_bench,
+    )
     from anyplan.experiments.suites import resolve_suite
-
-    from anyplan.experiments.planning_bench import OMPL_DEFAULT, ompl_available
 
     if args.suite == "planning":
         from anyplan.experiments.planning_problems import planning_suite

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from anyplan.errors import UsageError
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``import-crowd`` sub-command."""
@@ -52,8 +54,6 @@ def cmd_import_crowd(args: argparse.Namespace) -> int:
     try:
         paths = import_crowd(args.file, args.out, opt, args.name)
     except OSError as exc:
-        from anyplan.cli.main import UsageError
-
         raise UsageError(f"import-crowd: --out {args.out}: cannot write ({exc.strerror})") from None
     print(f"wrote {len(paths)} scenarios to {args.out}" +
           (f" ({paths[0].name} .. {paths[-1].name})" if paths else ""))

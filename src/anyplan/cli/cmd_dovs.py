@@ -6,6 +6,7 @@ import argparse
 import math
 
 from anyplan.cli import checks
+from anyplan.errors import UsageError
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -31,7 +32,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _parse_params(items: list[str]) -> dict[str, object]:
     from anyplan.baselines.dovs.config import DOVSConfig
-    from anyplan.cli.main import UsageError
 
     names = DOVSConfig.field_names()
     out: dict[str, object] = {}
@@ -63,7 +63,6 @@ def cmd_dovs_plot(args: argparse.Namespace) -> int:
     """Simulate DOVS up to ``--time`` and draw its decision there."""
     from anyplan.agents.base import Observation
     from anyplan.agents.dovs import DOVSAgent
-    from anyplan.cli.main import UsageError
     from anyplan.simulation.simulator import SimConfig, observe, simulate
     from anyplan.world.robot import RobotState
     from anyplan.world.scenario import load_scenario

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from anyplan.errors import UsageError
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``import-dynabarn`` sub-command."""
@@ -32,8 +34,6 @@ def cmd_import_dynabarn(args: argparse.Namespace) -> int:
     try:
         paths = convert(src, args.out, args.worlds)
     except OSError as exc:
-        from anyplan.cli.main import UsageError
-
         raise UsageError(f"import-dynabarn: --out {args.out}: cannot write ({exc.strerror})") from None
     print(f"wrote {len(paths)} scenarios to {args.out} ({paths[0].name} .. {paths[-1].name})"
           if paths else "no worlds selected")

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from anyplan.cli import checks
 from anyplan.cli.pictures import picture_path
+from anyplan.errors import UsageError
 from anyplan.planning.api import PLANNERS
 
 DEFAULT_TIME_S = 1.0
@@ -35,7 +36,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def cmd_plan(args: argparse.Namespace) -> int:
     """Run one planning query; exit code 0 if a path was found, 1 otherwise."""
-    from anyplan.cli.main import UsageError
     from anyplan.planning import Problem, make_planner, timed
     from anyplan.planning.visgraph import lower_bound
     from anyplan.world.scenario import load_scenario

@@ -10,6 +10,7 @@ from anyplan.agents.base import AGENTS, make_agent
 from anyplan.cli import checks
 from anyplan.cli.agent_options import add_agent_options, run_config
 from anyplan.cli.perception_opts import add_perception_options, apply_perception
+from anyplan.errors import UsageError
 from anyplan.simulation.simulator import SimConfig, simulate
 from anyplan.world.scenario import builtin_scenarios, load_scenario
 
@@ -64,7 +65,6 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
 
 def cmd_run(args: argparse.Namespace) -> int:
     """Simulate one run and write its result and picture."""
-    from anyplan.cli.main import UsageError
 
     scenario = apply_perception("run", [load_scenario(args.scenario)], args)[0]
     config = run_config(args, args.planner)  # unknown names and bad settings fail before any work

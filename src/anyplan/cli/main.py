@@ -17,7 +17,7 @@ import sys
 from collections.abc import Sequence
 
 from anyplan import __version__
-from anyplan.errors import AnyplanError, one_line
+from anyplan.errors import AnyplanError, UsageError, one_line
 
 __all__ = ["main", "COMMAND_MODULES", "UsageError"]
 
@@ -32,10 +32,6 @@ COMMAND_MODULES = [
     "anyplan.cli.cmd_dovs",
     "anyplan.cli.cmd_planners",
 ]
-
-
-class UsageError(AnyplanError):
-    """Bad command-line input detected after parsing (exit code 2)."""
 
 
 class _Parser(argparse.ArgumentParser):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 
+from anyplan.errors import UsageError
 from anyplan.world.scenario import Scenario
 from anyplan.world.sensing import DEFAULT_NOISE_M, DEFAULT_RATE_HZ, MODES
 
@@ -31,7 +32,6 @@ def apply_perception(command: str, scenarios: Sequence[Scenario],
     Raises:
         UsageError: an unknown mode, a negative noise, a rate that is not > 0 (exit code 2).
     """
-    from anyplan.cli.main import UsageError
     from anyplan.simulation.perception import override_sensing
 
     try:

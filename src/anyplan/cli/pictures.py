@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from anyplan.errors import UsageError
+
 __all__ = ["picture_path", "FORMATS"]
 
 #: Picture formats the commands write.
@@ -12,7 +14,6 @@ FORMATS = ("png", "svg", "pdf")
 
 def picture_path(target: str, fmt: str | None, command: str, option: str) -> Path:
     """The picture file of ``option`` ``target`` in format ``fmt`` (default: its suffix)."""
-    from anyplan.cli.main import UsageError
     from anyplan.errors import shorten
 
     path = Path(target)
