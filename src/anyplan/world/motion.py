@@ -16,10 +16,24 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["Motion", "UnicycleMotion", "WaypointMotion", "TrackMotion"]
+__all__ = ["Jump", "Motion", "UnicycleMotion", "WaypointMotion", "TrackMotion"]
+
+
+#: Tolerance [s] on a jump's time (:meth:`Motion.jumps`).
+_JUMP_EPS = 1e-9
+
+
+class Jump(NamedTuple):
+    """A discontinuity of a motion: at ``time`` [s] the position jumps from ``before`` to
+    ``after`` (both [m], shape (2,)); :meth:`Motion.position` gives ``after`` at ``time``."""
+
+    time: float
+    before: np.ndarray
+    after: np.ndarray
 
 
 class Motion:
@@ -43,9 +57,11 @@ class Motion:
         """Position at time ``t`` [s], shape (2,) [m]."""
         return self.positions(np.array([float(t)]))[0]
 
-    def state(self, t: float) -> tuple[float, float, float, float, float]:
-        """(x [m], y [m], heading [rad], v [m/s], omega [rad/s]) at time ``t`` [s]."""
-        raise NotImplementedError
+    def jumps(self, t0: float, t1: float) -> tuple[Jump, ...]:
+        """The jumps (teleports, not motions) of the position at times in (t0, t1] [s] (each
+        end moved 1 ns later, so that a jump at t1 is reported once, not again from t0 = t1),
+        in time order; none for a continuous motion."""
+        return ()
 
 
 @dataclass(frozen=True)
@@ -125,6 +141,21 @@ class WaypointMotion(Motion):
         k = self.keyframes
         seg = np.hypot(np.diff(k[:, 1]), np.diff(k[:, 2])) / np.diff(k[:, 0])
         return float(seg.max())
+
+    @property
+    def is_open(self) -> bool:
+        """True if the track does not end where it starts: it jumps back at every period."""
+        k = self.keyframes
+        return bool(k[-1, 1] != k[0, 1] or k[-1, 2] != k[0, 2])
+
+    def jumps(self, t0: float, t1: float) -> tuple[Jump, ...]:
+        """An open track jumps from its last keyframe back to its first at every multiple of
+        the period."""
+        if not self.is_open:
+            return ()
+        p, k = self.period, self.keyframes
+        n0, n1 = math.floor((t0 + _JUMP_EPS) / p) + 1, math.floor((t1 + _JUMP_EPS) / p)
+        return tuple(Jump(n * p, k[-1, 1:].copy(), k[0, 1:].copy()) for n in range(max(n0, 1), n1 + 1))
 
     def positions(self, t: np.ndarray) -> np.ndarray:
         tm = np.mod(np.asarray(t, dtype=float), self.period)
