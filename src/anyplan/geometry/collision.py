@@ -1,9 +1,10 @@
 """Exact collision and clearance queries for a disc robot among static shapes.
 
-An :class:`ObstacleSet` holds circles, simple polygons and optional arena walls in flat arrays
-consumed by compiled kernels. A disc robot of radius ``r`` centred at ``p`` is in collision
-iff ``clearance(p) < r``: this is the obstacle set *inflated* by ``r`` (the Minkowski sum with
-a disc, rounded corners included), tested exactly, with no sampling and no resolution.
+An :class:`ObstacleSet` holds circles, simple polygons and optional arena walls in flat arrays,
+handed to compiled kernels as one record, :class:`ObstacleArrays` (:attr:`ObstacleSet.arrays`).
+A disc robot of radius ``r`` centred at ``p`` is in collision iff ``clearance(p) < r``: this is
+the obstacle set *inflated* by ``r`` (the Minkowski sum with a disc, rounded corners included),
+tested exactly, with no sampling and no resolution.
 A straight motion from ``a`` to ``b`` is free iff the segment's clearance is ``>= r``.
 
 Examples:
@@ -23,15 +24,27 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-from anyplan.geometry import _kernels as k
+from anyplan.geometry import _clearance as k
+from anyplan.geometry._clearance import ObstacleArrays
 from anyplan.geometry.index import MIN_INDEXED, NO_GRID, build_grid
 from anyplan.geometry.shapes import Circle, Polygon, Shape
 
-__all__ = ["ObstacleSet", "COLLISION_EPS"]
+__all__ = ["ObstacleSet", "ObstacleArrays", "COLLISION_EPS", "segment_clearance_kernel",
+           "segment_blocked_kernel"]
 
 #: Tolerance [m] on contact: a clearance of ``r - COLLISION_EPS`` still counts as touching, not
 #: as penetrating, so that paths which graze an inflated boundary exactly are accepted.
 COLLISION_EPS = 1e-9
+
+#: Compiled ``(ax, ay, bx, by, obs: ObstacleArrays, stop_below) -> float``: the minimum distance
+#: [m] from segment ab to the obstacles and walls (0 on contact); returns early, with some value
+#: below ``stop_below``, once the clearance is known to be below it (``-1`` for the exact
+#: minimum). Callable from Python and from other ``@njit`` code.
+segment_clearance_kernel = k.segment_clearance
+#: Compiled ``(ax, ay, bx, by, obs: ObstacleArrays, limit) -> bool``: True iff the exact
+#: clearance of segment ab is < ``limit`` [m] (pass/fail only: on a map it scans only the cells
+#: within ``limit`` of the segment). Callable from Python and from other ``@njit`` code.
+segment_blocked_kernel = k.segment_blocked
 
 
 class ObstacleSet:
@@ -95,8 +108,8 @@ class ObstacleSet:
                             else np.array(self.bounds, dtype=float))
 
     def _pack(self) -> None:
-        self._args = (self.vx, self.vy, self.starts, self.pbox, self.circles, self._bounds_arr,
-                      self._gmeta, self._gcsr)
+        self._arrays = ObstacleArrays(self.vx, self.vy, self.starts, self.pbox, self.circles,
+                                      self._bounds_arr, self._gmeta, self._gcsr)
 
     def __len__(self) -> int:
         return len(self.shapes) + len(self.boxes)
@@ -129,15 +142,18 @@ class ObstacleSet:
         return out
 
     @property
-    def kernel_args(self) -> tuple[np.ndarray, ...]:
-        """Flat arrays ``(vx, vy, starts, pbox, circles, bounds, gmeta, gcsr)`` for the
-        compiled kernels (:mod:`anyplan.geometry._kernels` documents the layout)."""
-        return self._args
+    def arrays(self) -> ObstacleArrays:
+        """The obstacles as one record of flat arrays for compiled kernels
+        (:class:`ObstacleArrays` documents the layout)."""
+        return self._arrays
 
     # --- single queries -------------------------------------------------------------------
+    # (the record's fields one by one: see the note on the py_* entries in _clearance)
     def clearance(self, point: Sequence[float] | np.ndarray) -> float:
         """Distance [m] from ``point`` to the nearest obstacle or wall (0 inside one)."""
-        return float(k.point_clearance(float(point[0]), float(point[1]), *self._args))
+        o = self._arrays
+        return float(k.py_point_clearance(float(point[0]), float(point[1]), o.vx, o.vy, o.starts,
+                                          o.pbox, o.circles, o.bounds, o.gmeta, o.gcsr))
 
     def point_free(self, point: Sequence[float] | np.ndarray, radius: float) -> bool:
         """True if a disc of ``radius`` [m] at ``point`` touches no obstacle and no wall."""
@@ -146,22 +162,28 @@ class ObstacleSet:
     def segment_clearance(self, a: Sequence[float] | np.ndarray,
                           b: Sequence[float] | np.ndarray) -> float:
         """Exact minimum distance [m] from segment ``ab`` to the obstacles and walls."""
-        return float(k.segment_clearance(float(a[0]), float(a[1]), float(b[0]), float(b[1]),
-                                         *self._args, -1.0))
+        o = self._arrays
+        return float(k.py_segment_clearance(float(a[0]), float(a[1]), float(b[0]), float(b[1]),
+                                            o.vx, o.vy, o.starts, o.pbox, o.circles, o.bounds,
+                                            o.gmeta, o.gcsr, -1.0))
 
     def segment_free(self, a: Sequence[float] | np.ndarray, b: Sequence[float] | np.ndarray,
                      radius: float) -> bool:
         """True if a disc of ``radius`` [m] moving straight from ``a`` to ``b`` touches nothing."""
+        o = self._arrays
         limit = radius - COLLISION_EPS
-        return not k.segment_blocked(float(a[0]), float(a[1]), float(b[0]), float(b[1]),
-                                     *self._args, limit)
+        return not k.py_segment_blocked(float(a[0]), float(a[1]), float(b[0]), float(b[1]),
+                                        o.vx, o.vy, o.starts, o.pbox, o.circles, o.bounds,
+                                        o.gmeta, o.gcsr, limit)
 
     # --- batched queries ------------------------------------------------------------------
     def clearances(self, points: np.ndarray) -> np.ndarray:
         """Clearance of each point, ``points`` shape (N, 2), result shape (N,) [m]."""
+        o = self._arrays
         p = np.ascontiguousarray(np.asarray(points, dtype=float).reshape(-1, 2))
-        return k.points_clearance(np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1]),
-                                  *self._args)
+        return k.py_points_clearance(np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1]),
+                                     o.vx, o.vy, o.starts, o.pbox, o.circles, o.bounds, o.gmeta,
+                                     o.gcsr)
 
     def points_free(self, points: np.ndarray, radius: float) -> np.ndarray:
         """Boolean mask (N,): a disc of ``radius`` at each point touches nothing."""
@@ -170,27 +192,30 @@ class ObstacleSet:
     def points_clear(self, points: np.ndarray, limit: float) -> np.ndarray:
         """Boolean mask (N,): the clearance of each point is >= ``limit`` [m]; the same answer
         as ``clearances(points) >= limit``, faster on maps (it stops at ``limit``)."""
+        o = self._arrays
         p = np.ascontiguousarray(np.asarray(points, dtype=float).reshape(-1, 2))
-        return k.points_clear(np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1]),
-                              *self._args, float(limit))
+        return k.py_points_clear(np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1]),
+                                 o.vx, o.vy, o.starts, o.pbox, o.circles, o.bounds, o.gmeta,
+                                 o.gcsr, float(limit))
 
     def segments_clearance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Exact clearance of each segment ``a[i] -> b[i]``, both shape (N, 2); result (N,)."""
-        a = np.asarray(a, dtype=float).reshape(-1, 2)
-        b = np.asarray(b, dtype=float).reshape(-1, 2)
-        return k.segments_clearance(np.ascontiguousarray(a[:, 0]), np.ascontiguousarray(a[:, 1]),
-                                    np.ascontiguousarray(b[:, 0]), np.ascontiguousarray(b[:, 1]),
-                                    *self._args, -1.0)
+        return self._segments_clearance(a, b, -1.0)
 
     def segments_free(self, a: np.ndarray, b: np.ndarray, radius: float) -> np.ndarray:
         """Boolean mask (N,): a disc of ``radius`` moving along each segment touches nothing."""
+        limit = radius - COLLISION_EPS
+        return self._segments_clearance(a, b, limit) >= limit
+
+    def _segments_clearance(self, a: np.ndarray, b: np.ndarray, stop_below: float) -> np.ndarray:
+        o = self._arrays
         a = np.asarray(a, dtype=float).reshape(-1, 2)
         b = np.asarray(b, dtype=float).reshape(-1, 2)
-        limit = radius - COLLISION_EPS
-        c = k.segments_clearance(np.ascontiguousarray(a[:, 0]), np.ascontiguousarray(a[:, 1]),
-                                 np.ascontiguousarray(b[:, 0]), np.ascontiguousarray(b[:, 1]),
-                                 *self._args, limit)
-        return c >= limit
+        return k.py_segments_clearance(np.ascontiguousarray(a[:, 0]),
+                                       np.ascontiguousarray(a[:, 1]),
+                                       np.ascontiguousarray(b[:, 0]),
+                                       np.ascontiguousarray(b[:, 1]), o.vx, o.vy, o.starts,
+                                       o.pbox, o.circles, o.bounds, o.gmeta, o.gcsr, stop_below)
 
     def path_free(self, path: np.ndarray, radius: float) -> bool:
         """True if every segment of the polyline ``path`` (N, 2) is free for the disc robot."""

@@ -45,7 +45,7 @@ def build_grid(pbox: np.ndarray, cell: float | None = None,
 
     Returns:
         ``gmeta`` (7,) = (x0, y0, cell, nx, ny, P, 0) and ``gcsr`` (int64), see
-        :mod:`anyplan.geometry._kernels`.
+        :class:`anyplan.geometry.collision.ObstacleArrays`.
     """
     b = np.asarray(pbox, dtype=float).reshape(-1, 4)
     n = len(b)

@@ -188,7 +188,7 @@ def closest_approach(pos_a: PositionFn, pos_b: PositionFn, rel_speed_bound: floa
     intervals = [(ts[j], ts[j + 1], fs[j], fs[j + 1]) for j in range(n)]
     evals = n + 1
     while intervals and evals < MAX_EVALUATIONS:
-        nxt = []
+        nxt: list[tuple[float, float, float, float]] = []
         for a, b, fa, fb in intervals:
             if 0.5 * (fa + fb - L * (b - a)) >= best - L * tol or b - a <= tol:
                 continue

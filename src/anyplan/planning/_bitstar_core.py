@@ -24,7 +24,7 @@ import math
 import numpy as np
 from numba import njit
 
-from anyplan.geometry import _kernels as gk
+from anyplan.geometry.collision import ObstacleArrays, segment_blocked_kernel
 
 # Scalar slots.
 S_CBEST, S_R, S_X0, S_Y0, S_CELL, S_LIMIT = 0, 1, 2, 3, 4, 5
@@ -312,9 +312,7 @@ def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np
             ek: np.ndarray, ep: np.ndarray, cstart: np.ndarray, citems: np.ndarray,
             nstart: np.ndarray, nitems: np.ndarray, S: np.ndarray, N: np.ndarray,
             stack: np.ndarray, nb: np.ndarray, nd: np.ndarray,
-            ovx: np.ndarray, ovy: np.ndarray, ostarts: np.ndarray, opbox: np.ndarray,
-            ocircles: np.ndarray, obounds: np.ndarray, ogmeta: np.ndarray, ogcsr: np.ndarray,
-            max_iter: int) -> int:
+            obs: ObstacleArrays, max_iter: int) -> int:
     """Run one batch for up to ``max_iter`` units of work (edge pops plus vertex expansions).
 
     Returns RC_IMPROVED as soon as the goal's cost drops, RC_BATCH_DONE when the batch cannot
@@ -369,8 +367,7 @@ def iterate(P: np.ndarray, F: np.ndarray, IT: np.ndarray, vk: np.ndarray, vp: np
             continue
         # Exact, lazy edge check: is the straight motion free for the disc robot?
         N[N_CHECKS] += 1
-        if gk.segment_blocked(P[a, 0], P[a, 1], P[b, 0], P[b, 1], ovx, ovy, ostarts, opbox,
-                              ocircles, obounds, ogmeta, ogcsr, limit):
+        if segment_blocked_kernel(P[a, 0], P[a, 1], P[b, 0], P[b, 1], obs, limit):
             N[N_FAILS] += 1
             continue
         # The true cost equals the heuristic (straight line), so the tests above stand.
@@ -504,9 +501,7 @@ def compact(P: np.ndarray, F: np.ndarray, IT: np.ndarray, N: np.ndarray, state: 
 
 
 @njit(cache=True)
-def blocked_edges(P: np.ndarray, IT: np.ndarray, n: int, ovx: np.ndarray, ovy: np.ndarray,
-                  ostarts: np.ndarray, opbox: np.ndarray, ocircles: np.ndarray,
-                  obounds: np.ndarray, ogmeta: np.ndarray, ogcsr: np.ndarray,
+def blocked_edges(P: np.ndarray, IT: np.ndarray, n: int, obs: ObstacleArrays,
                   limit: float) -> np.ndarray:
     """Mask of vertices whose tree edge (parent -> vertex) is blocked by the given obstacles."""
     out = np.zeros(n, np.bool_)
@@ -514,7 +509,6 @@ def blocked_edges(P: np.ndarray, IT: np.ndarray, n: int, ovx: np.ndarray, ovy: n
         p = IT[i, PAR]
         if p < 0:
             continue
-        if gk.segment_blocked(P[p, 0], P[p, 1], P[i, 0], P[i, 1], ovx, ovy, ostarts, opbox,
-                              ocircles, obounds, ogmeta, ogcsr, limit):
+        if segment_blocked_kernel(P[p, 0], P[p, 1], P[i, 0], P[i, 1], obs, limit):
             out[i] = True
     return out

@@ -446,7 +446,7 @@ class BITStar(Planner):
 
     def _solve(self, ptc: TerminationCondition | float) -> PlannerStatus:
         ptc = as_condition(ptc).bind(self)
-        obs_args = self._obs.kernel_args
+        obs = self._obs.arrays
         t0 = time.perf_counter()
         clock_base = self._solve_time - t0
         if self.n_batches == 0 and not math.isfinite(self.best_cost):
@@ -463,7 +463,7 @@ class BITStar(Planner):
             tc = time.perf_counter()
             rc = core.iterate(self._P, self._F, self._I, self._vk, self._vp, self._ek, self._ep,
                               self._cstart, self._citems, self._nstart, self._nitems, self._S,
-                              self._N, self._stack, self._nb, self._nd, *obs_args, self._chunk)
+                              self._N, self._stack, self._nb, self._nd, obs, self._chunk)
             dt = time.perf_counter() - tc
             if rc == core.RC_BUDGET:
                 # Adapt the chunk so that ptc() is polled about every chunk_s seconds.
@@ -537,7 +537,7 @@ class BITStar(Planner):
         state = np.where((self._I[:n, core.FLAGS] & core.F_VERTEX) != 0, 2, 1).astype(np.int64)
         free = new_only.clearances(self._P[:n]) >= self._limit
         state[~free] = 0
-        blocked = core.blocked_edges(self._P, self._I, n, *new_only.kernel_args, self._limit)
+        blocked = core.blocked_edges(self._P, self._I, n, new_only.arrays, self._limit)
         state[blocked & free] = 1
         core.compact(self._P, self._F, self._I, self._N, state, self._stack)
         old_cost = self.best_cost

@@ -36,8 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from anyplan.geometry import _kernels as gk
-from anyplan.geometry.collision import ObstacleSet
+from anyplan.geometry.collision import ObstacleArrays, ObstacleSet, segment_blocked_kernel
 from anyplan.geometry.shapes import Circle, Polygon
 from anyplan.planning._visgraph_boxes import convex_box_corners, corner_arcs, inscribed_radius
 from anyplan.planning.base import Planner, PlanResult
@@ -317,15 +316,13 @@ def _tangent(ux: float, uy: float, px: float, py: float, qx: float, qy: float, v
 @njit(cache=True)
 def _edges(px: np.ndarray, py: np.ndarray, prv: np.ndarray, nxt: np.ndarray, n_free: int,
            exact: bool, radius: float, starts: np.ndarray, box: np.ndarray, nx: np.ndarray,
-           ny: np.ndarray, off: np.ndarray, ovx: np.ndarray, ovy: np.ndarray,
-           ostarts: np.ndarray, opbox: np.ndarray, ocircles: np.ndarray,
-           obounds: np.ndarray, ogmeta: np.ndarray, ogcsr: np.ndarray,
+           ny: np.ndarray, off: np.ndarray, obs: ObstacleArrays,
            box_limit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Visible bitangent edges; nodes ``[0, n_free)`` (start, goal) skip the tangent test.
 
-    ``exact``: the exact test at ``radius`` against the obstacle arrays ``o*``; else the
+    ``exact``: the exact test at ``radius`` against the obstacle record ``obs``; else the
     interior test of the components and, if ``box_limit`` > 0, the exact test at
-    ``box_limit`` against the arrays ``o*`` (then a map's boxes alone)."""
+    ``box_limit`` against ``obs`` (then a map's boxes alone)."""
     n = px.shape[0]
     cap = 1024
     ei = np.empty(cap, np.int64)
@@ -341,16 +338,14 @@ def _edges(px: np.ndarray, py: np.ndarray, prv: np.ndarray, nxt: np.ndarray, n_f
                                             nxt[j, 1], px[i], py[i]):
                 continue
             if exact:
-                if gk.segment_blocked(px[i], py[i], px[j], py[j], ovx, ovy, ostarts, opbox,
-                                      ocircles, obounds, ogmeta, ogcsr, limit):
+                if segment_blocked_kernel(px[i], py[i], px[j], py[j], obs, limit):
                     continue
             else:
                 if _segment_hits_any(px[i], py[i], px[j], py[j], starts, box, nx, ny, off,
                                      1e-9):
                     continue
-                if box_limit > 0.0 and gk.segment_blocked(px[i], py[i], px[j], py[j], ovx, ovy,
-                                                          ostarts, opbox, ocircles, obounds,
-                                                          ogmeta, ogcsr, box_limit):
+                if box_limit > 0.0 and segment_blocked_kernel(px[i], py[i], px[j], py[j], obs,
+                                                              box_limit):
                     continue
             if m == cap:
                 cap *= 2
@@ -439,10 +434,9 @@ def shortest_path(problem: Problem, *, variant: str = "feasible",
     if not prune_tangent:
         prv = nxt = np.ascontiguousarray(np.repeat(pts[:, None, :], 1, axis=1)[:, 0, :])
     exact = variant == "feasible"
-    oargs = problem.obstacles.kernel_args if exact or box_limit <= 0.0 else \
-        _box_set(problem).kernel_args
+    oarr = problem.obstacles.arrays if exact or box_limit <= 0.0 else _box_set(problem).arrays
     ei, ej, w = _edges(np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), prv, nxt,
-                       2, exact, problem.check_radius, starts, box, nx, ny, off, *oargs, box_limit)
+                       2, exact, problem.check_radius, starts, box, nx, ny, off, oarr, box_limit)
     from scipy.sparse import coo_matrix  # lazy: keeps `import anyplan.planning` light
     from scipy.sparse.csgraph import dijkstra
 

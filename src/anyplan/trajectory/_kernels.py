@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
-from anyplan.geometry._kernels import segment_blocked, segment_clearance
+from anyplan.geometry.collision import ObstacleArrays, segment_blocked_kernel, segment_clearance_kernel
 
 # Gauss-Legendre nodes/weights on [0, 1] (5 points: exact for polynomials of degree 9).
 _X, _W = np.polynomial.legendre.leggauss(5)
@@ -492,9 +492,7 @@ def curve_sample(x: np.ndarray, c: np.ndarray, s_grid: np.ndarray, u_grid: np.nd
 
 @njit(cache=True)
 def certify(x: np.ndarray, c: np.ndarray, u: np.ndarray, limit: float, radius: float,
-            max_depth: int, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
-            circles: np.ndarray, bounds: np.ndarray, gmeta: np.ndarray,
-            gcsr: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+            max_depth: int, obs: ObstacleArrays) -> tuple[np.ndarray, np.ndarray, float]:
     """Certified chord test of the pieces [u_j, u_{j+1}] with up to ``max_depth`` 4-way splits.
 
     A piece is certified when (exact chord clearance) - M h^2 / 8 >= ``limit``
@@ -523,8 +521,7 @@ def certify(x: np.ndarray, c: np.ndarray, u: np.ndarray, limit: float, radius: f
         last = depth == max_depth
         for j in range(n):
             stop = -1.0 if last else limit + dev[j] - 1e-9
-            cl = segment_clearance(pa[j, 0], pa[j, 1], pb[j, 0], pb[j, 1], vx, vy, starts, pbox,
-                                   circles, bounds, gmeta, gcsr, stop)
+            cl = segment_clearance_kernel(pa[j, 0], pa[j, 1], pb[j, 0], pb[j, 1], obs, stop)
             if cl < stop:
                 fail[j] = True
                 nf += 1
@@ -688,9 +685,7 @@ def clean_points(p: np.ndarray, tol: float, collinear_tol: float) -> np.ndarray:
 
 
 @njit(cache=True)
-def shortcut_indices(p: np.ndarray, limit: float, vx: np.ndarray, vy: np.ndarray,
-                     starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
-                     bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray) -> np.ndarray:
+def shortcut_indices(p: np.ndarray, limit: float, obs: ObstacleArrays) -> np.ndarray:
     """Indices kept by ``spline.shortcut_path``: from each kept vertex, the farthest one whose
     straight segment has clearance >= ``limit`` (else the next vertex). Scanning from the far end
     with the query stopping early below ``limit`` gives exactly the pass/fail of the exact
@@ -703,8 +698,7 @@ def shortcut_indices(p: np.ndarray, limit: float, vx: np.ndarray, vy: np.ndarray
     while i < n - 1:
         nxt = i + 1
         for j in range(n - 1, i + 1, -1):
-            if not segment_blocked(p[i, 0], p[i, 1], p[j, 0], p[j, 1], vx, vy, starts, pbox,
-                                   circles, bounds, gmeta, gcsr, limit):
+            if not segment_blocked_kernel(p[i, 0], p[i, 1], p[j, 0], p[j, 1], obs, limit):
                 nxt = j
                 break
         keep[nk] = nxt
@@ -823,10 +817,8 @@ def _argsort_stable(v: np.ndarray) -> np.ndarray:
 
 @njit(cache=True)
 def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarray, limit: float,
-                  radius: float, max_depth: int, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray,
-                  pbox: np.ndarray, circles: np.ndarray,
-                  bounds: np.ndarray, gmeta: np.ndarray,
-                  gcsr: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+                  radius: float, max_depth: int,
+                  obs: ObstacleArrays) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """:func:`certify` reduced to what the repair uses, by branch and bound.
 
     Returns, for each interpolation interval k (``point_u[k:k+2]``) that has a piece failing at
@@ -853,6 +845,10 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
     margin = np.inf
     # Rounding allowance of the bound: distances here are computed from coordinates of size
     # <= scale with absolute errors of a few ulp(scale) ~ 1e-15 scale; allow 1e-11 scale.
+    bounds = obs.bounds
+    vx = obs.vx
+    vy = obs.vy
+    circles = obs.circles
     scale = 1.0
     for j in range(c.shape[0]):
         scale = max(scale, abs(c[j, 0, 0]), abs(c[j, 0, 1]))
@@ -872,8 +868,7 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
     hint = np.int64(0)  # not a literal: one specialisation of the callee
     for j in range(m):
         pax, pay, pbx, pby, dev, hint = _chord_dev_one(x, c, u[j], u[j + 1], hint)
-        cl = segment_clearance(pax, pay, pbx, pby, vx, vy, starts, pbox, circles, bounds, gmeta,
-                               gcsr, -1.0)
+        cl = segment_clearance_kernel(pax, pay, pbx, pby, obs, -1.0)
         cj = cl - dev
         if cj >= limit:
             margin = min(margin, cj - radius)
@@ -931,9 +926,7 @@ def certify_worst(x: np.ndarray, c: np.ndarray, u: np.ndarray, point_u: np.ndarr
                 a2 = a + w * (p / 4.0)
                 b2 = a + w * ((p + 1) / 4.0)
                 pax, pay, pbx, pby, dev, h2 = _chord_dev_one(x, c, a2, b2, h2)
-                cl = segment_clearance(pax, pay, pbx, pby, vx, vy, starts, pbox, circles, bounds,
-                                       gmeta, gcsr,
-                                       -1.0)
+                cl = segment_clearance_kernel(pax, pay, pbx, pby, obs, -1.0)
                 c2 = cl - dev
                 if c2 >= limit:
                     margin = min(margin, c2 - radius)

@@ -115,7 +115,7 @@ def shortcut_path(path: np.ndarray, obstacles: ObstacleSet, radius: float) -> np
     p = np.asarray(path, dtype=float).reshape(-1, 2)
     if len(p) <= 2:
         return p.copy()
-    keep = _k.shortcut_indices(np.ascontiguousarray(p), radius - COLLISION_EPS, *obstacles.kernel_args)
+    keep = _k.shortcut_indices(np.ascontiguousarray(p), radius - COLLISION_EPS, obstacles.arrays)
     return p[keep]
 
 
@@ -256,7 +256,7 @@ def _certify(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
     # when (exact chord clearance) - max(|r''(a)|, |r''(b-)|) (b - a)^2 / 8 >= radius - eps,
     # with r'' at b taken slightly inside the piece to stay on the same cubic.
     fail_u, fail_c, margin = _k.certify(curve._x, curve._c, curve.u_grid, radius - COLLISION_EPS,
-                                        float(radius), int(max_depth), *obstacles.kernel_args)
+                                        float(radius), int(max_depth), obstacles.arrays)
     return curve.point_index(fail_u), fail_u, fail_c, margin
 
 
@@ -266,7 +266,7 @@ def _worst_failures(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
     its first failing piece of least certified clearance (k, midpoint u, clearance), found by
     branch and bound (see ``_kernels.certify_worst``); the margin is valid when nothing fails."""
     return _k.certify_worst(curve._x, curve._c, curve.u_grid, curve.point_u, radius - COLLISION_EPS,
-                            float(radius), int(max_depth), *obstacles.kernel_args)
+                            float(radius), int(max_depth), obstacles.arrays)
 
 
 def curve_clearance_ok(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,

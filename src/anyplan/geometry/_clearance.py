@@ -1,27 +1,13 @@
-"""Compiled (numba) kernels for exact planar distance queries.
+"""Compiled (numba) clearance kernels: exact distances from points and segments to obstacles.
 
-All functions work on plain floats and flat arrays so that numba compiles them once and caches
-the machine code on disk (``cache=True``). The public, documented API is
-:class:`anyplan.geometry.collision.ObstacleSet`.
+Every kernel takes the obstacle set as one record, :class:`ObstacleArrays` (defined here beside
+its kernels, public as ``anyplan.geometry.collision.ObstacleArrays``; it documents the layout), and
+plain floats, so numba compiles it once and caches the machine code (``cache=True``). The
+public entry points for other packages' compiled code are re-exported by
+:mod:`anyplan.geometry.collision` (``segment_clearance_kernel``, ``segment_blocked_kernel``);
+Python code uses :class:`~anyplan.geometry.collision.ObstacleSet`.
 
-Data layout of an obstacle set:
-    vx, vy: polygon vertex coordinates [m], all polygons concatenated, shape (V,).
-    starts: offsets of each polygon's first vertex, shape (P + 1,); polygon k owns
-        vertices ``starts[k]:starts[k + 1]``.
-    pbox: polygon bounding boxes (xmin, ymin, xmax, ymax), shape (P, 4).
-    circles: (cx, cy, radius), shape (C, 3).
-    bounds: arena (xmin, ymin, xmax, ymax); the robot must stay inside. ``bounds[0] > bounds[2]``
-        disables the walls.
-    gmeta: uniform-grid index over the first polygons, (x0, y0, cell [m], nx, ny, n_indexed,
-        n_boxes); ``nx == 0`` means no index (every polygon is scanned, as for a few obstacles).
-        The first ``n_boxes`` polygons are axis-aligned boxes equal to their ``pbox`` rows
-        (tested by a cheaper exact formula).
-        Polygons ``n_indexed:`` are always scanned linearly (e.g. a few added to a map).
-    gcsr: the grid's cells in CSR form, int64: ``gcsr[c]:gcsr[c + 1]`` (c = row * nx + col) are
-        positions in ``gcsr`` holding the indices of the polygons whose bounding box meets the
-        cell. See :mod:`anyplan.geometry.index`.
-
-A query against the grid is exact: it scans the cells within a distance R of the query
+A query against the grid index is exact: it scans the cells within a distance R of the query
 (a conservative, padded cover of the capsule), and R grows until the best distance found is
 <= R, so no polygon nearer than the answer can be skipped.
 """
@@ -29,11 +15,43 @@ A query against the grid is exact: it scans the cells within a distance R of the
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 INF = math.inf
+
+
+class ObstacleArrays(NamedTuple):
+    """An obstacle set as flat arrays, one argument of the compiled kernels (numba accepts a
+    NamedTuple of arrays). Produced only by :attr:`ObstacleSet.arrays`.
+
+    P polygons (the map's boxes first), V vertices in all, C circles.
+    """
+
+    #: Polygon vertex x coordinates [m], all polygons concatenated, shape (V,).
+    vx: np.ndarray
+    #: Polygon vertex y coordinates [m], shape (V,).
+    vy: np.ndarray
+    #: int64 offsets, shape (P + 1,): polygon k owns vertices ``starts[k]:starts[k + 1]``.
+    starts: np.ndarray
+    #: Polygon bounding boxes (xmin, ymin, xmax, ymax) [m], shape (P, 4).
+    pbox: np.ndarray
+    #: Circles (cx, cy, radius) [m], shape (C, 3).
+    circles: np.ndarray
+    #: Arena (xmin, ymin, xmax, ymax) [m], shape (4,); the robot must stay inside.
+    #: ``bounds[0] > bounds[2]`` disables the walls.
+    bounds: np.ndarray
+    #: Uniform-grid index over the first polygons, (x0, y0, cell [m], nx, ny, n_indexed,
+    #: n_boxes); ``nx == 0`` means no index (every polygon is scanned). The first ``n_boxes``
+    #: polygons are axis-aligned boxes equal to their ``pbox`` rows (a cheaper exact test);
+    #: polygons ``n_indexed:`` are always scanned linearly (e.g. a few added to a map).
+    gmeta: np.ndarray
+    #: The grid's cells in CSR form, int64: ``gcsr[c]:gcsr[c + 1]`` (c = row * nx + col) are
+    #: positions in ``gcsr`` holding the indices of the polygons whose bounding box meets the
+    #: cell (:mod:`anyplan.geometry.index`).
+    gcsr: np.ndarray
 
 
 @njit(cache=True, inline="always")
@@ -161,15 +179,19 @@ def _box_d2(ax: float, ay: float, bx: float, by: float, x0: float, y0: float, x1
 
 @njit(cache=True)
 def _grid_scan(ax: float, ay: float, bx: float, by: float, rad: float, best: float,
-               stop_below: float, exact: bool, vx: np.ndarray, vy: np.ndarray,
-               starts: np.ndarray, pbox: np.ndarray, gmeta: np.ndarray,
-               gcsr: np.ndarray) -> float:
+               stop_below: float, exact: bool, obs: ObstacleArrays) -> float:
     """min(best, distance to the indexed polygons met by the cells within ``rad`` of ab).
 
     Every polygon at distance <= ``rad`` from ab is tested (the cover is padded against
     rounding); returns early once the distance is 0 or below ``stop_below``. With ``exact``
     False only polygons nearer than ``stop_below`` matter (the others are skipped by the lower
     bounds of their boxes)."""
+    vx = obs.vx
+    vy = obs.vy
+    starts = obs.starts
+    pbox = obs.pbox
+    gmeta = obs.gmeta
+    gcsr = obs.gcsr
     x0 = gmeta[0]
     y0 = gmeta[1]
     h = gmeta[2]
@@ -242,12 +264,12 @@ def _grid_scan(ax: float, ay: float, bx: float, by: float, rad: float, best: flo
 
 @njit(cache=True)
 def _grid_clearance(ax: float, ay: float, bx: float, by: float, best: float, stop_below: float,
-                    exact: bool, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray,
-                    pbox: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray) -> float:
+                    exact: bool, obs: ObstacleArrays) -> float:
     """min(best, distance from ab to the indexed polygons), by scans of growing radius.
 
     Exact unless the result is below ``stop_below`` (then some value below it) or, with
     ``exact`` False, unless it is >= ``stop_below`` (then some value >= it: pass/fail only)."""
+    gmeta = obs.gmeta
     h = gmeta[2]
     gx0 = gmeta[0]
     gy0 = gmeta[1]
@@ -259,8 +281,7 @@ def _grid_clearance(ax: float, ay: float, bx: float, by: float, best: float, sto
     if rad > best:
         rad = best
     while True:
-        best = _grid_scan(ax, ay, bx, by, rad, best, stop_below, exact, vx, vy, starts, pbox,
-                          gmeta, gcsr)
+        best = _grid_scan(ax, ay, bx, by, rad, best, stop_below, exact, obs)
         if best <= 0.0 or best < stop_below or not exact:
             return best
         if best <= rad or rad >= rmax:
@@ -269,10 +290,15 @@ def _grid_clearance(ax: float, ay: float, bx: float, by: float, best: float, sto
 
 
 @njit(cache=True)
-def point_clearance(px: float, py: float, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray,
-                    pbox: np.ndarray, circles: np.ndarray, bounds: np.ndarray,
-                    gmeta: np.ndarray, gcsr: np.ndarray) -> float:
+def point_clearance(px: float, py: float, obs: ObstacleArrays) -> float:
     """Distance [m] from point p to the nearest obstacle or wall; 0 inside an obstacle."""
+    vx = obs.vx
+    vy = obs.vy
+    starts = obs.starts
+    pbox = obs.pbox
+    circles = obs.circles
+    bounds = obs.bounds
+    gmeta = obs.gmeta
     best = INF
     if bounds[0] <= bounds[2]:
         dw = min(px - bounds[0], bounds[2] - px, py - bounds[1], bounds[3] - py)
@@ -302,15 +328,20 @@ def point_clearance(px: float, py: float, vx: np.ndarray, vy: np.ndarray, starts
                 best = math.sqrt(d2)
             j = i
     if gmeta[3] > 0.0:
-        best = _grid_clearance(px, py, px, py, best, 0.0, True, vx, vy, starts, pbox, gmeta, gcsr)
+        best = _grid_clearance(px, py, px, py, best, 0.0, True, obs)
     return best
 
 
 @njit(cache=True)
-def _segment_clearance(ax: float, ay: float, bx: float, by: float, vx: np.ndarray,
-                       vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
-                       bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray,
+def _segment_clearance(ax: float, ay: float, bx: float, by: float, obs: ObstacleArrays,
                        stop_below: float, exact: bool) -> float:
+    vx = obs.vx
+    vy = obs.vy
+    starts = obs.starts
+    pbox = obs.pbox
+    circles = obs.circles
+    bounds = obs.bounds
+    gmeta = obs.gmeta
     best = INF
     if bounds[0] <= bounds[2]:
         # The distance to the boundary of a convex region is concave along a segment inside
@@ -355,67 +386,115 @@ def _segment_clearance(ax: float, ay: float, bx: float, by: float, vx: np.ndarra
                     return best
             j = i
     if gmeta[3] > 0.0:
-        best = _grid_clearance(ax, ay, bx, by, best, stop_below, exact, vx, vy, starts, pbox,
-                               gmeta, gcsr)
+        best = _grid_clearance(ax, ay, bx, by, best, stop_below, exact, obs)
     return best
 
 
 @njit(cache=True)
-def segment_clearance(ax: float, ay: float, bx: float, by: float, vx: np.ndarray, vy: np.ndarray,
-                      starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
-                      bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray,
+def segment_clearance(ax: float, ay: float, bx: float, by: float, obs: ObstacleArrays,
                       stop_below: float) -> float:
     """Minimum distance [m] from segment ab to any obstacle or wall (0 on contact).
 
     Returns early, with some value below ``stop_below``, as soon as the clearance is known to
     be smaller than ``stop_below`` (pass ``-1`` for the exact minimum); otherwise exact.
     """
-    return _segment_clearance(ax, ay, bx, by, vx, vy, starts, pbox, circles, bounds, gmeta, gcsr,
-                              stop_below, True)
+    return _segment_clearance(ax, ay, bx, by, obs, stop_below, True)
 
 
 @njit(cache=True)
-def segment_blocked(ax: float, ay: float, bx: float, by: float, vx: np.ndarray, vy: np.ndarray,
-                    starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
-                    bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray,
+def segment_blocked(ax: float, ay: float, bx: float, by: float, obs: ObstacleArrays,
                     limit: float) -> bool:
     """True iff the exact clearance of segment ab is < ``limit`` [m] (pass/fail only: on a map
     it scans only the cells within ``limit`` of the segment)."""
-    return _segment_clearance(ax, ay, bx, by, vx, vy, starts, pbox, circles, bounds, gmeta, gcsr,
-                              limit, False) < limit
+    return _segment_clearance(ax, ay, bx, by, obs, limit, False) < limit
 
 
 @njit(cache=True)
-def points_clearance(px: np.ndarray, py: np.ndarray, vx: np.ndarray, vy: np.ndarray,
-                     starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
-                     bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray) -> np.ndarray:
+def points_clearance(px: np.ndarray, py: np.ndarray, obs: ObstacleArrays) -> np.ndarray:
     """Vectorised :func:`point_clearance`, shape (N,)."""
     out = np.empty(px.shape[0])
     for n in range(px.shape[0]):
-        out[n] = point_clearance(px[n], py[n], vx, vy, starts, pbox, circles, bounds, gmeta, gcsr)
+        out[n] = point_clearance(px[n], py[n], obs)
     return out
 
 
 @njit(cache=True)
-def points_clear(px: np.ndarray, py: np.ndarray, vx: np.ndarray, vy: np.ndarray,
-                 starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray, bounds: np.ndarray,
-                 gmeta: np.ndarray, gcsr: np.ndarray, limit: float) -> np.ndarray:
+def points_clear(px: np.ndarray, py: np.ndarray, obs: ObstacleArrays, limit: float) -> np.ndarray:
     """Mask (N,): the exact clearance of each point is >= ``limit`` [m] (pass/fail only)."""
     out = np.empty(px.shape[0], dtype=np.bool_)
     for n in range(px.shape[0]):
-        out[n] = _segment_clearance(px[n], py[n], px[n], py[n], vx, vy, starts, pbox, circles,
-                                    bounds, gmeta, gcsr, limit, False) >= limit
+        out[n] = _segment_clearance(px[n], py[n], px[n], py[n], obs, limit, False) >= limit
     return out
 
 
 @njit(cache=True)
 def segments_clearance(ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray,
-                       vx: np.ndarray, vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
-                       circles: np.ndarray, bounds: np.ndarray, gmeta: np.ndarray,
-                       gcsr: np.ndarray, stop_below: float) -> np.ndarray:
+                       obs: ObstacleArrays, stop_below: float) -> np.ndarray:
     """Vectorised :func:`segment_clearance`, shape (N,)."""
     out = np.empty(ax.shape[0])
     for n in range(ax.shape[0]):
-        out[n] = segment_clearance(ax[n], ay[n], bx[n], by[n], vx, vy, starts, pbox, circles,
-                                   bounds, gmeta, gcsr, stop_below)
+        out[n] = segment_clearance(ax[n], ay[n], bx[n], by[n], obs, stop_below)
     return out
+
+
+# --- entries for calls from Python ---------------------------------------------------------
+# numba types a NamedTuple argument from Python on its slow path (about 2 us per call more
+# than eight arrays), so ObstacleSet's methods pass the record's fields and the record is
+# rebuilt here, in compiled code, for free. Compiled callers pass the record itself.
+
+@njit(cache=True)
+def py_point_clearance(px: float, py: float, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray,
+                       pbox: np.ndarray, circles: np.ndarray, bounds: np.ndarray,
+                       gmeta: np.ndarray, gcsr: np.ndarray) -> float:
+    """:func:`point_clearance` of the record made of the given fields."""
+    return point_clearance(px, py, ObstacleArrays(vx, vy, starts, pbox, circles, bounds, gmeta,
+                                                  gcsr))
+
+
+@njit(cache=True)
+def py_segment_clearance(ax: float, ay: float, bx: float, by: float, vx: np.ndarray,
+                         vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
+                         circles: np.ndarray, bounds: np.ndarray, gmeta: np.ndarray,
+                         gcsr: np.ndarray, stop_below: float) -> float:
+    """:func:`segment_clearance` of the record made of the given fields."""
+    return segment_clearance(ax, ay, bx, by, ObstacleArrays(vx, vy, starts, pbox, circles,
+                                                            bounds, gmeta, gcsr), stop_below)
+
+
+@njit(cache=True)
+def py_segment_blocked(ax: float, ay: float, bx: float, by: float, vx: np.ndarray,
+                       vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
+                       circles: np.ndarray, bounds: np.ndarray, gmeta: np.ndarray,
+                       gcsr: np.ndarray, limit: float) -> bool:
+    """:func:`segment_blocked` of the record made of the given fields."""
+    return segment_blocked(ax, ay, bx, by, ObstacleArrays(vx, vy, starts, pbox, circles, bounds,
+                                                          gmeta, gcsr), limit)
+
+
+@njit(cache=True)
+def py_points_clearance(px: np.ndarray, py: np.ndarray, vx: np.ndarray, vy: np.ndarray,
+                        starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
+                        bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray) -> np.ndarray:
+    """:func:`points_clearance` of the record made of the given fields."""
+    return points_clearance(px, py, ObstacleArrays(vx, vy, starts, pbox, circles, bounds, gmeta,
+                                                   gcsr))
+
+
+@njit(cache=True)
+def py_points_clear(px: np.ndarray, py: np.ndarray, vx: np.ndarray, vy: np.ndarray,
+                    starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
+                    bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray,
+                    limit: float) -> np.ndarray:
+    """:func:`points_clear` of the record made of the given fields."""
+    return points_clear(px, py, ObstacleArrays(vx, vy, starts, pbox, circles, bounds, gmeta,
+                                               gcsr), limit)
+
+
+@njit(cache=True)
+def py_segments_clearance(ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray,
+                          vx: np.ndarray, vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
+                          circles: np.ndarray, bounds: np.ndarray, gmeta: np.ndarray,
+                          gcsr: np.ndarray, stop_below: float) -> np.ndarray:
+    """:func:`segments_clearance` of the record made of the given fields."""
+    return segments_clearance(ax, ay, bx, by, ObstacleArrays(vx, vy, starts, pbox, circles,
+                                                             bounds, gmeta, gcsr), stop_below)
