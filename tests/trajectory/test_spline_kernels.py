@@ -9,8 +9,10 @@ import pytest
 from scipy.interpolate import CubicSpline, make_interp_spline
 
 from anyplan.geometry import Circle, ObstacleSet
-from anyplan.trajectory import _kernels as k
 from anyplan.trajectory.spline import START_KNOT, SmoothCurve, clean_path, shortcut_path
+from anyplan.trajectory.spline._fit import cubic_spline
+from anyplan.trajectory.spline._pp import pp_eval
+from anyplan.trajectory.spline.clearance import failing_pieces, worst_failures, worst_per_group
 
 
 def _points(seed: int, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -39,10 +41,10 @@ def test_cubic_spline_matches_scipy(seed, n):
     u = np.concatenate([np.linspace(x[0] - 0.5, x[-1] + 0.5, 501), x])
     scale = 1.0 + np.abs(y).max()
     for mode, ref in refs.items():
-        bx, bc = k.cubic_spline(x, y, mode, tan, nrm, extra)
+        bx, bc = cubic_spline(x, y, mode, tan, nrm, extra)
         assert len(bx) == len(x) + (mode == 2)
         for nu in range(4):
-            got = k.pp_eval(bx, bc, u, nu)
+            got = pp_eval(bx, bc, u, nu)
             want = ref(u, nu)
             # the third derivative jumps at the breakpoints: compare away from them only
             sel = np.min(np.abs(u[:, None] - bx[None, :]), axis=1) > 1e-9 if nu == 3 else slice(None)
@@ -89,7 +91,7 @@ def test_clean_path_keeps_turns_and_last_point():
 
 def _reduce(kk: np.ndarray, fu: np.ndarray, fc: np.ndarray) -> tuple[list, list, list]:
     """Per interval, the first failing piece of least clearance (what the repair uses)."""
-    ks, idx = k.worst_per_group(kk.astype(np.int64), fc)
+    ks, idx = worst_per_group(kk.astype(np.int64), fc)
     return ks.tolist(), fu[idx].tolist(), fc[idx].tolist()
 
 
@@ -97,8 +99,6 @@ def _reduce(kk: np.ndarray, fu: np.ndarray, fc: np.ndarray) -> tuple[list, list,
 def test_branch_and_bound_finds_the_same_worst_pieces(seed):
     # The repair's reduced certification (branch and bound) against the full one: same intervals,
     # same worst piece and clearance in each (exactly), and the same margin when the curve is free.
-    from anyplan.trajectory.spline import _certify, _worst_failures
-
     rng = np.random.default_rng(seed)
     pts = np.cumsum(rng.uniform(-1.0, 2.0, (6, 2)), axis=0)
     c = SmoothCurve(pts, start_heading=float(rng.uniform(-np.pi, np.pi)) if seed % 2 else None,
@@ -111,8 +111,8 @@ def test_branch_and_bound_finds_the_same_worst_pieces(seed):
     for radius in (0.05, 0.3, true_min - 1e-3, true_min + 1e-3, true_min + 0.3):
         if radius <= 0.0:
             continue
-        kk, fu, fc, margin = _certify(c, obs, radius, 4)
-        ks, bu, bc, bmargin = _worst_failures(c, obs, radius, 4)
+        kk, fu, fc, margin = failing_pieces(c, obs, radius, 4)
+        ks, bu, bc, bmargin = worst_failures(c, obs, radius, 4)
         assert _reduce(kk, fu, fc) == (ks.tolist(), bu.tolist(), bc.tolist())
         if len(kk) == 0:
             assert bmargin == margin

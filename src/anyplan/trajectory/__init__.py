@@ -3,14 +3,15 @@
 The entry point is :func:`plan_motion` (polyline -> :class:`Trajectory`).
 """
 
+from anyplan.trajectory.kinds import ST_PREFIX, MotionKind, SegmentKind
 from anyplan.trajectory.motion import plan_motion, polyline_trajectory, turn_segment
-from anyplan.trajectory.profile import SpeedProfile, time_lower_bound, time_parameterize
+from anyplan.trajectory.path import clean_path, shortcut_path
+from anyplan.trajectory.profile import ProfileArrays, SpeedProfile, time_lower_bound, time_parameterize
 from anyplan.trajectory.spline import (
+    CurveArrays,
     SmoothCurve,
     SmoothingResult,
-    clean_path,
     curve_clearance_ok,
-    shortcut_path,
     smooth_path,
 )
 from anyplan.trajectory.trajectory import (
@@ -23,6 +24,11 @@ from anyplan.trajectory.trajectory import (
 from anyplan.trajectory.turn import RotationProfile, rotation_profile
 
 __all__ = [
+    "ST_PREFIX",
+    "CurveArrays",
+    "MotionKind",
+    "ProfileArrays",
+    "SegmentKind",
     "BrakeSegment",
     "CurveSegment",
     "RotationProfile",

@@ -24,8 +24,10 @@ import numpy as np
 
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.geometry.se2 import wrap_angle
+from anyplan.trajectory.kinds import MotionKind
+from anyplan.trajectory.path import clean_path, shortcut_path
 from anyplan.trajectory.profile import time_lower_bound, time_parameterize
-from anyplan.trajectory.spline import SmoothCurve, clean_path, shortcut_path, smooth_path
+from anyplan.trajectory.spline import SmoothCurve, smooth_path
 from anyplan.trajectory.trajectory import (
     BrakeSegment,
     CurveSegment,
@@ -126,7 +128,8 @@ def polyline_trajectory(path: np.ndarray, spec: RobotSpec, state: RobotState, t_
         t = cs.t1
     if not segs:
         segs.append(TurnSegment(x, y, rotation_profile(th, 0.0, spec.omega_max, spec.alpha_max, 0.0), t))
-    return Trajectory(segs, kind="polyline", lower_bound_s=time_lower_bound(length, spec, abs(state.v)),
+    return Trajectory(segs, kind=MotionKind.POLYLINE,
+                      lower_bound_s=time_lower_bound(length, spec, abs(state.v)),
                       polyline=pts, certified_free=free)
 
 
@@ -191,7 +194,7 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         seg: Segment = brake if brake is not None else TurnSegment(
             state.x, state.y, rotation_profile(state.theta, 0.0, spec.omega_max, spec.alpha_max,
                                                state.omega), t_start)
-        return Trajectory([seg], kind="hold", lower_bound_s=0.0, polyline=pts)
+        return Trajectory([seg], kind=MotionKind.HOLD, lower_bound_s=0.0, polyline=pts)
     v0 = max(state.v, 0.0)
     cands: list[tuple[bool, float, Trajectory]] = []
     info: dict = {"candidates": {}, "input_vertices": n_input, "vertices": len(pts)}
@@ -214,7 +217,7 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         k_start, _ = res.curve.curvature(np.array([0.0]))
         ok_a = ok_a and abs(float(k_start[0]) * float(prof.v[0]) - state.omega) <= start_omega_tolerance
         seg_a = CurveSegment(res.curve, prof, t_start)
-        tr = Trajectory([seg_a], kind="smooth", feasible=ok_a,
+        tr = Trajectory([seg_a], kind=MotionKind.SMOOTH, feasible=ok_a,
                         lower_bound_s=time_lower_bound(res.curve.length, spec, v0), polyline=pts,
                         info={"repair_rounds": res.rounds, "points_added": res.points_added,
                               "certified_margin_m": res.margin})
@@ -240,7 +243,8 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         if res_b.curve is not None and brake_free:
             prof = time_parameterize(res_b.curve, spec, 0.0)
             segs.append(CurveSegment(res_b.curve, prof, t))
-            tr = Trajectory(segs, kind="brake+turn+smooth" if braked else "turn+smooth",
+            tr = Trajectory(segs, kind=(MotionKind.BRAKE_TURN_SMOOTH if braked
+                                      else MotionKind.TURN_SMOOTH),
                             feasible=True,
                             lower_bound_s=time_lower_bound(res_b.curve.length, spec, 0.0),
                             polyline=pts_b,

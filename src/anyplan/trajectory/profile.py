@@ -1,49 +1,30 @@
 """Time-optimal speed profile along a fixed curve under the robot's limits (forward/backward passes).
 
-The limits of a differential-drive robot moving along a curve with curvature kappa(s):
-
-* speed: ``v <= v_max``;
-* turn rate: ``|omega| = v |kappa| <= omega_max``;
-* linear acceleration: ``|dv/dt| <= a_max``;
-* angular acceleration: ``|d omega/dt| = |kappa' v^2 + kappa dv/dt| <= alpha_max``
-  (kappa' = dkappa/ds).
-
-With x = v^2 as the state, dx/ds = 2 dv/dt. The profile is piecewise *constant acceleration*:
-x is linear in s on each grid interval [s_i, s_{i+1}] with slope d_i = 2 a_i. On an interval,
-let K_i and K'_i bound |kappa| and |kappa'| (dense sub-samples, inflated). Then for every s in
-the interval, not only at the grid points,
-
-* v(s) <= v_max and v |kappa| <= omega_max hold if x_i and x_{i+1} are both below
-  ``min(v_max^2, (omega_max / K_i)^2)`` (x is linear, so its maximum is at an end);
-* |dv/dt| = |d_i| / 2 <= a_max;
-* |d omega/dt| <= K'_i max(x_i, x_{i+1}) + K_i |d_i| / 2 <= alpha_max.
-
-This is the classic numerical integration scheme for time-optimal path parameterisation
-(Bobrow, Dubowsky & Gibson 1985; Shin & McKay 1985; Pham 2014 "A general, fast, and robust
-implementation of the time-optimal path parameterization algorithm"): a maximum velocity curve,
-a backward pass that brakes as late as possible from the goal at rest, then a forward pass that
-accelerates as hard as possible from the current speed, each clipped by the other. The
-alpha-constraint couples a and v; with the interval bounds above both passes remain exact
-minimisers of the grid-constrained problem, and the final profile satisfies every interval
-constraint (proof in the comments of :func:`time_parameterize`).
-
-The time lower bound (:func:`time_lower_bound`) ignores curvature: length / v_max plus the time
-lost accelerating from the current speed and braking to rest at a_max.
+Limits of a differential-drive robot along a curve with curvature kappa(s): v <= v_max,
+|omega| = v |kappa| <= omega_max, |dv/dt| <= a_max and |d omega/dt| = |kappa' v^2 + kappa dv/dt|
+<= alpha_max (kappa' = dkappa/ds). With x = v^2 as the state the profile is piecewise constant
+acceleration on a grid in s; bounds K_i, K'_i of |kappa|, |kappa'| on each interval make every
+limit hold everywhere between grid points, not only at them. The scheme is the classic numerical
+integration for time-optimal path parameterisation (Bobrow, Dubowsky & Gibson 1985; Shin & McKay
+1985; Pham 2014): a maximum velocity curve, a backward pass braking as late as possible from
+rest at the goal, a forward pass accelerating as hard as possible from the current speed.
+The time lower bound (:func:`time_lower_bound`) ignores curvature.
+Derivation and measurements: ``docs/motion.md`` ("Speed profile").
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from anyplan.trajectory import _kernels as _k
 from anyplan.trajectory.spline import SmoothCurve
 from anyplan.world.robot import RobotSpec
 
-__all__ = ["SpeedProfile", "time_parameterize", "time_lower_bound"]
+__all__ = ["ProfileArrays", "SpeedProfile", "time_parameterize", "time_lower_bound"]
 
 #: Relative inflation of the sampled curvature bounds on each grid interval.
 KAPPA_INFLATION = 1.02
@@ -53,6 +34,18 @@ _FR = np.linspace(0.0, 1.0, SUBSAMPLES + 1)
 # keep the right end inside the same cubic piece: kappa' jumps at the knots
 _FR[-1] = 1.0 - 1e-9
 _FR[0] = 1e-9
+
+
+class ProfileArrays(NamedTuple):
+    """The grid of a :class:`SpeedProfile` as contiguous float arrays, one argument of compiled
+    kernels. Produced only by :attr:`SpeedProfile.arrays`."""
+
+    #: Arc length [m] at the grid, shape (M,).
+    s: np.ndarray
+    #: Speed [m/s] at the grid, shape (M,).
+    v: np.ndarray
+    #: Time [s] since the profile's start at the grid, shape (M,).
+    t: np.ndarray
 
 
 @dataclass
@@ -86,6 +79,13 @@ class SpeedProfile:
         return float(self.t[-1])
 
     @property
+    def arrays(self) -> ProfileArrays:
+        """(s, v, t) as one :class:`ProfileArrays` record (for compiled kernels)."""
+        return ProfileArrays(np.ascontiguousarray(self.s, dtype=float),
+                             np.ascontiguousarray(self.v, dtype=float),
+                             np.ascontiguousarray(self.t, dtype=float))
+
+    @property
     def accel(self) -> np.ndarray:
         """Constant acceleration [m/s^2] on each interval (M-1,)."""
         return (self.v[1:] ** 2 - self.v[:-1] ** 2) / (2.0 * np.diff(self.s))
@@ -105,7 +105,7 @@ def _interval_bounds(curve: SmoothCurve, u: np.ndarray) -> tuple[np.ndarray, np.
     """Bounds on |kappa| and |kappa'| over each interval [u_i, u_{i+1}] (never across a knot)."""
     # Sub-samples at fractions fr of each interval; endpoint values, exactly at the grid points,
     # also count for |kappa| (kappa is continuous).
-    k, dk = _k.abs_curvature_max(curve._x, curve._c, np.ascontiguousarray(u, dtype=float), _FR, True)
+    k, dk = curve.curvature_bounds(u, _FR, True)
     return k * KAPPA_INFLATION + 1e-9, dk * KAPPA_INFLATION + 1e-9
 
 

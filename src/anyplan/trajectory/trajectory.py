@@ -5,75 +5,51 @@ predict, continuously in time, whether the robot will meet a moving obstacle. It
 
 * :class:`CurveSegment`: driving along a :class:`~anyplan.trajectory.spline.SmoothCurve` with a
   :class:`~anyplan.trajectory.profile.SpeedProfile`;
-* :class:`TurnSegment`: turning in place (:mod:`anyplan.trajectory.turn`);
-* :class:`BrakeSegment`: braking to rest from the current twist (v and omega decelerated at
-  a_max and alpha_max), integrated finely (error < 1e-6 m).
+* :class:`~anyplan.trajectory.turn.TurnSegment`: turning in place;
+* :class:`~anyplan.trajectory.brake.BrakeSegment`: braking to rest from the current twist.
 
 Times are absolute simulation times [s]. Before ``t_start`` the trajectory is held at its start
-state, after ``t_end`` at its end pose with zero twist.
+state, after ``t_end`` at its end pose with zero twist. See ``docs/motion.md``
+("``plan_motion`` and ``Trajectory``").
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
 
-from anyplan.trajectory import _kernels as _k
+from anyplan.trajectory.brake import BrakeSegment
+from anyplan.trajectory.kinds import MotionKind, SegmentKind
 from anyplan.trajectory.profile import SpeedProfile
+from anyplan.trajectory.segment import Sample, Segment
 from anyplan.trajectory.spline import SmoothCurve
-from anyplan.trajectory.turn import RotationProfile
+from anyplan.trajectory.turn import TurnSegment
 
 __all__ = ["Segment", "CurveSegment", "TurnSegment", "BrakeSegment", "Trajectory"]
-
-Sample = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
-
-
-class Segment:
-    """A piece of reference motion on [t0, t1] (absolute times [s])."""
-
-    t0: float
-    t1: float
-    #: Bound on the speed of the reference position [m/s].
-    max_speed: float = 0.0
-    #: Distance driven [m].
-    length: float = 0.0
-
-    def sample(self, t: np.ndarray) -> Sample:
-        """(x, y, theta, v, omega) at times ``t`` (clamped to the segment)."""
-        raise NotImplementedError
-
-    def path_points(self, step: float) -> np.ndarray:
-        """Geometric points (M, 2) [m] visited by the segment."""
-        raise NotImplementedError
 
 
 class CurveSegment(Segment):
     """Driving along ``curve`` with ``profile``, starting at absolute time ``t0`` [s]."""
 
-    kind = "curve"
+    kind = SegmentKind.CURVE
 
     def __init__(self, curve: SmoothCurve, profile: SpeedProfile, t0: float) -> None:
         self.curve, self.profile = curve, profile
         self.t0 = float(t0)
         self.t1 = self.t0 + profile.duration
         self.length = curve.length
-        c = curve
-        self._args = (c._x, c._c, c.s_grid, c.u_grid, c._dus, c.length,
-                      np.ascontiguousarray(profile.s, dtype=float),
-                      np.ascontiguousarray(profile.v, dtype=float),
-                      np.ascontiguousarray(profile.t, dtype=float))
+        self._prof = profile.arrays
         self._max_speed: float | None = None
 
     @property
-    def max_speed(self) -> float:  # type: ignore[override]
+    def max_speed(self) -> float:
         """Bound on the speed of the reference position [m/s] (computed on first use)."""
         # |d position/dt| = |r'(u(s))| u'(s) v: measure the first factor (1 to ~1e-6) finely,
         # as chord lengths over 8 equal parts of each profile interval, times the larger end
         # speed of the interval, plus 1 %.
         if self._max_speed is None:
-            self._max_speed = ((_k.speed_bound(*self._args[:8], 8) * 1.01)
+            self._max_speed = ((self.curve.profile_speed_bound(self._prof, 8) * 1.01)
                                if len(self.profile.s) > 1 else 0.0)
         return self._max_speed
 
@@ -83,81 +59,13 @@ class CurveSegment(Segment):
 
     def sample(self, t: np.ndarray) -> Sample:
         t = np.asarray(t, dtype=float)
-        out = _k.curve_sample(*self._args, t.ravel() - self.t0)
+        out = self.curve.sample_profile(self._prof, t.ravel() - self.t0)
         if t.ndim == 1:
             return out[0], out[1], out[2], out[3], out[4]
-        return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
+        return tuple(o.reshape(t.shape) for o in out)
 
     def path_points(self, step: float) -> np.ndarray:
         return self.curve.samples(step)
-
-
-class TurnSegment(Segment):
-    """Turning in place at (x, y) [m] following ``rotation``, from absolute time ``t0`` [s]."""
-
-    kind = "turn"
-
-    def __init__(self, x: float, y: float, rotation: RotationProfile, t0: float) -> None:
-        self.x, self.y, self.rotation = float(x), float(y), rotation
-        self.t0 = float(t0)
-        self.t1 = self.t0 + rotation.duration
-        self.max_speed = 0.0
-        self.length = 0.0
-
-    def sample(self, t: np.ndarray) -> Sample:
-        t = np.asarray(t, dtype=float)
-        th, w = self.rotation.at_time(t - self.t0)
-        return (np.full(t.shape, self.x), np.full(t.shape, self.y), th, np.zeros(t.shape), w)
-
-    def path_points(self, step: float) -> np.ndarray:
-        return np.array([[self.x, self.y]])
-
-
-class BrakeSegment(Segment):
-    """Braking to rest: v and omega go to zero at a_max and alpha_max, from time ``t0`` [s]."""
-
-    kind = "brake"
-
-    def __init__(self, x: float, y: float, theta: float, v0: float, omega0: float, a_max: float,
-                 alpha_max: float, t0: float, dt: float = 0.002) -> None:
-        self.v0, self.w0, self.a, self.al = float(v0), float(omega0), a_max, alpha_max
-        self.theta0 = float(theta)
-        self.t0 = float(t0)
-        dur = max(abs(v0) / a_max, abs(omega0) / alpha_max)
-        self.t1 = self.t0 + dur
-        n = max(2, math.ceil(dur / dt) + 1)
-        self._tau = np.linspace(0.0, dur, n)
-        _, _, th, v, _ = self._twist(self._tau)
-        # Midpoint-of-interval integration with the exact heading: error O(dt^2 * v * omega).
-        tm = 0.5 * (self._tau[:-1] + self._tau[1:])
-        _, _, thm, vm, _ = self._twist(tm)
-        h = np.diff(self._tau)
-        self._x = x + np.concatenate([[0.0], np.cumsum(vm * np.cos(thm) * h)])
-        self._y = y + np.concatenate([[0.0], np.cumsum(vm * np.sin(thm) * h)])
-        self.max_speed = abs(self.v0) * 1.001
-        self.length = float(np.sum(np.abs(vm) * h))
-
-    def _twist(self, tau: np.ndarray) -> Sample:
-        tau = np.asarray(tau, dtype=float)
-        tv = abs(self.v0) / self.a
-        tw = abs(self.w0) / self.al
-        sv = math.copysign(self.a, self.v0)
-        sw = math.copysign(self.al, self.w0)
-        cv, cw = np.minimum(tau, tv), np.minimum(tau, tw)
-        v = self.v0 - sv * cv
-        w = self.w0 - sw * cw
-        th = self.theta0 + self.w0 * cw - 0.5 * sw * cw * cw
-        z = np.zeros(tau.shape)
-        return z, z, th, v, w
-
-    def sample(self, t: np.ndarray) -> Sample:
-        t = np.asarray(t, dtype=float)
-        out = _k.brake_eval(t.ravel() - self.t0, self.t1 - self.t0, self.v0,
-                            self.w0, self.theta0, self.a, self.al, self._tau, self._x, self._y)
-        return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
-
-    def path_points(self, step: float) -> np.ndarray:
-        return np.column_stack([self._x, self._y])
 
 
 #: Segment types whose ``sample`` returns new arrays that share no memory.
@@ -169,7 +77,8 @@ class Trajectory:
 
     Attributes:
         segments: The segments, contiguous in time.
-        kind: How it was built (``"smooth"``, ``"turn+smooth"``, ``"polyline"``, ...).
+        kind: How it was built: a :class:`~anyplan.trajectory.kinds.MotionKind` (``"smooth"``,
+            ``"turn+smooth"``, ``"polyline"``, ...) or a prefixed one (``"st+smooth"``, ...).
         feasible: False when the robot's current state could not be followed within its limits
             (the trajectory is then a best effort).
         lower_bound_s: Time lower bound [s] for driving :attr:`length` from the start speed to
@@ -181,7 +90,8 @@ class Trajectory:
         info: Diagnostics (repair rounds, candidate times, ...).
     """
 
-    def __init__(self, segments: Sequence[Segment], kind: str = "smooth", feasible: bool = True,
+    def __init__(self, segments: Sequence[Segment], kind: str = MotionKind.SMOOTH,
+                 feasible: bool = True,
                  lower_bound_s: float = float("nan"), polyline: np.ndarray | None = None,
                  info: dict | None = None, certified_free: bool = True) -> None:
         if not segments:

@@ -150,8 +150,8 @@ def goal_times(forbidden: np.ndarray, t_map: float, h: float, c_goal: int, reach
     The relaxation of every lattice motion: within a row the robot advances by at most ``reach``
     cells (v_max h / ds, rounded up, plus one), through free cells of that row, with unbounded
     acceleration; each bound is also raised to the distance bound t + (c_goal - c - 1) ds / v_max
-    (the max of two lower bounds is one). Backward over the rows; inf marks cells from which the goal cannot be reached
-    within the map (the search drops them).
+    (the max of two lower bounds is one). Backward over the rows; inf marks cells from which the
+    goal cannot be reached within the map (the search drops them).
     """
     nrow, ncell = forbidden.shape
     g = np.full((nrow + 1, ncell), np.inf)
@@ -299,23 +299,24 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
         if m_goal < 0:
             continue
         acts = _search(forbidden, float(t_map), float(h), float(ds), xcap0, xcap1, float(t_a),
-                      float(s_a), int(k_a), float(a_max), float(dt), int(kmax), int(m_goal), n_max, int(key_cells), gt)
+                       float(s_a), int(k_a), float(a_max), float(dt), int(kmax), int(m_goal), n_max,
+                       int(key_cells), gt)
         if len(acts) == 1 and acts[0] == -9:
             continue
-        k = np.concatenate([[k_a], k_a + np.cumsum(acts)])
-        m = np.concatenate([[0], np.cumsum(2 * k[:-1] + acts)])
-        t = t_a + dt * np.arange(len(k))
-        s = s_a + delta * m
-        v = vstep * k
-        a = a_max * acts.astype(float)
+        ks = np.concatenate([[k_a], k_a + np.cumsum(acts)])
+        ms = np.concatenate([[0], np.cumsum(2 * ks[:-1] + acts)])
+        ts = t_a + dt * np.arange(len(ks))
+        ss = s_a + delta * ms
+        vs = vstep * ks
+        accs = a_max * acts.astype(float)
         if tau0 > 0.0:
-            t = np.concatenate([[t0], t])
-            s = np.concatenate([[0.0], s])
-            v = np.concatenate([[v0], v])
-            a = np.concatenate([[acc0], a])
-        if len(a) == 0:  # already at rest at the end
-            t, s, v, a = np.array([t0, t0]), np.array([s_a, s_a]), np.zeros(2), np.zeros(1)
-        plan = VelocityPlan(t, s, v, a)
+            ts = np.concatenate([[t0], ts])
+            ss = np.concatenate([[0.0], ss])
+            vs = np.concatenate([[v0], vs])
+            accs = np.concatenate([[acc0], accs])
+        if len(accs) == 0:  # already at rest at the end
+            ts, ss, vs, accs = np.array([t0, t0]), np.array([s_a, s_a]), np.zeros(2), np.zeros(1)
+        plan = VelocityPlan(ts, ss, vs, accs)
         if best is None or plan.arrival_s < best.arrival_s:
             best = plan
     return best

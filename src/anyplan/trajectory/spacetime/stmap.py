@@ -137,9 +137,9 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     pad = np.full(ng * _CHUNK, np.nan)
     gxs, gys = pad.copy(), pad.copy()
     gxs[:ncell], gys[:ncell] = px, py
-    gxs, gys = gxs.reshape(ng, _CHUNK), gys.reshape(ng, _CHUNK)
-    cx, cy = np.nanmean(gxs, axis=1), np.nanmean(gys, axis=1)
-    crad = np.nanmax(np.hypot(gxs - cx[:, None], gys - cy[:, None]), axis=1)
+    cxs, cys = gxs.reshape(ng, _CHUNK), gys.reshape(ng, _CHUNK)
+    cx, cy = np.nanmean(cxs, axis=1), np.nanmean(cys, axis=1)
+    crad = np.nanmax(np.hypot(cxs - cx[:, None], cys - cy[:, None]), axis=1)
     n_free = int(math.floor(max(length - free_tail_m, 0.0) / ds)) if free_tail_m > 0.0 else ncell
     gx, gy = float(px.mean()), float(py.mean())
     grad = float(np.max(np.hypot(px - gx, py - gy)))

@@ -23,6 +23,7 @@ from numba import njit
 
 from anyplan.prediction.base import PredictedObstacle
 from anyplan.prediction.collision import PredictedCollision, first_collision
+from anyplan.trajectory.kinds import ST_PREFIX, SegmentKind
 from anyplan.trajectory.profile import SpeedProfile
 from anyplan.trajectory.spacetime.lattice import VelocityPlan, plan_velocity
 from anyplan.trajectory.spacetime.stmap import STMap, build_stmap, radii_at
@@ -36,7 +37,7 @@ __all__ = ["TimedCurveSegment", "speed_caps", "retime", "verify", "RetimeResult"
 class TimedCurveSegment(Segment):
     """Driving along ``curve`` with a :class:`VelocityPlan` (absolute times), waits included."""
 
-    kind = "st-curve"
+    kind = SegmentKind.ST_CURVE
 
     def __init__(self, curve: SmoothCurve, plan: VelocityPlan) -> None:
         self.curve, self.plan = curve, plan
@@ -155,7 +156,7 @@ def retime(traj: Trajectory, obstacles: Sequence[Any], spec: RobotSpec, *, margi
                          spec.a_max, spec.v_max, target_dt=target_dt, horizon_s=horizon)
     if plan is None:
         return RetimeResult(None, None, stmap, nominal)
-    new = Trajectory(list(segs[:-1]) + [TimedCurveSegment(curve, plan)], kind="st+" + traj.kind,
+    new = Trajectory(list(segs[:-1]) + [TimedCurveSegment(curve, plan)], kind=ST_PREFIX + traj.kind,
                      feasible=traj.feasible, lower_bound_s=traj.lower_bound_s,
                      polyline=traj.polyline, certified_free=traj.certified_free,
                      info=dict(traj.info, wait_s=plan.wait_s, nominal_end_s=nominal))
@@ -189,10 +190,9 @@ def _first_contact_growing(motion: Any, o: Any, reach0: float, t0: float, t1: fl
                   float(r[i + 1]))]
         while stack:
             a, b, da, db, ra, rb = stack.pop()
-            if db <= reach0 + rb:
-                # contact at b at the latest: search [a, b] finer unless already fine
-                if b - a <= tol:
-                    return a
+            # contact at b at the latest: search [a, b] finer unless already fine
+            if db <= reach0 + rb and b - a <= tol:
+                return a
             if 0.5 * (da + db - vr * (b - a)) > reach0 + max(ra, rb):
                 continue
             if b - a <= tol:

@@ -1,0 +1,111 @@
+"""Smoothing a path into a certified collision-free curve (:func:`smooth_path`).
+
+A :class:`~anyplan.trajectory.spline.SmoothCurve` is fitted through the cleaned path and repaired
+until :mod:`~anyplan.trajectory.spline.clearance` certifies it: in every interpolation interval
+that is not certified, the worst point is projected onto the interval's polyline segment and
+that projection (kept to the middle 60 % of the segment) becomes a new interpolation point. New
+points lie on the polyline, so the route is unchanged while the spline is pulled back toward the
+segments where it strayed (``repair="midpoint"`` splits the segment and its neighbours instead).
+If repair fails, the caller falls back to the polyline (:mod:`anyplan.trajectory.motion`).
+Paper: Roy, Harchowdhury & Vachhani, "Anytime Planning: A Motion Planner for Dynamic
+Environment", §4. Measurements: ``docs/motion.md`` ("Smoothing and collision certification").
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from anyplan.geometry.collision import ObstacleSet
+from anyplan.trajectory.path import clean_path
+from anyplan.trajectory.spline.clearance import worst_failures, worst_per_group
+from anyplan.trajectory.spline.curve import SmoothCurve
+
+__all__ = ["SmoothingResult", "smooth_path"]
+
+
+@dataclass
+class SmoothingResult:
+    """Outcome of :func:`smooth_path`.
+
+    Attributes:
+        curve: The certified collision-free curve, or None if repair failed or the curve has a
+            cusp (see :meth:`SmoothCurve.is_regular`).
+        rounds: Repair rounds used (0: the first spline was free).
+        points_added: Interpolation points inserted by the repair.
+        margin: Certified clearance above the required radius [m] (nan if no curve).
+    """
+
+    curve: SmoothCurve | None
+    rounds: int
+    points_added: int
+    margin: float
+
+
+def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
+                start_heading: float | None = None, max_rounds: int = 10,
+                grid_step: float = 0.02, min_segment: float = 0.02,
+                repair: str = "project", start_curvature: float | None = None) -> SmoothingResult:
+    """Fit a cubic spline through ``path`` and repair it until it is certified collision-free.
+
+    Args:
+        path: Polyline (N, 2) [m]; its first and last points are kept exactly.
+        obstacles: Static obstacles (including any virtual ones) and walls.
+        radius: Required clearance [m] of the curve.
+        start_heading: Heading [rad] the curve must start with, or None.
+        max_rounds: Repair rounds before giving up.
+        grid_step: Evaluation grid spacing [m] (see :class:`SmoothCurve`).
+        min_segment: Polyline segments shorter than this [m] are not split further.
+        start_curvature: Curvature [1/m] at the start (with ``start_heading``), see
+            :class:`SmoothCurve`.
+        repair: ``"project"`` (default): in each interval that is not certified, insert the
+            projection of its worst point onto the polyline segment (clamped to the middle 60 %
+            of the segment); ``"midpoint"``: split that segment and both neighbours in half.
+
+    Returns:
+        A :class:`SmoothingResult`; ``curve`` is None when no certified curve was found.
+    """
+    pts = clean_path(path)
+    if len(pts) < 2:
+        raise ValueError("path must contain two distinct points")
+    n0 = len(pts)
+    for rnd in range(max_rounds + 1):
+        curve = SmoothCurve(pts, start_heading=start_heading, grid_step=grid_step,
+                            start_curvature=start_curvature)
+        if not curve.is_regular():
+            # a cusp comes from the start heading, which no repair changes
+            return SmoothingResult(None, rnd, len(pts) - n0, float("nan"))
+        kk, fu, fc, margin = worst_failures(curve, obstacles, radius, 4)
+        if len(kk) == 0:
+            return SmoothingResult(curve, rnd, len(pts) - n0, margin)
+        if rnd == max_rounds:
+            break
+        if repair == "midpoint":
+            # Split the offending polyline segments and their neighbours at their midpoints.
+            split = {j: 0.5 for k in np.unique(kk).tolist() for j in (k - 1, k, k + 1)
+                     if 0 <= j < len(pts) - 1}
+        else:
+            # Project the worst point of each offending interval onto its polyline segment and
+            # insert it there (kept away from the ends so that segments shrink geometrically).
+            split = {}
+            for k, j in zip(*worst_per_group(kk, fc), strict=True):
+                k = int(k)
+                q = curve.position(fu[j:j + 1])[0]
+                a, b = pts[k], pts[k + 1]
+                ab = b - a
+                lam = float((q - a) @ ab) / float(ab @ ab)
+                split[k] = min(max(lam, 0.2), 0.8)
+        new = [pts[0]]
+        added = 0
+        for j in range(len(pts) - 1):
+            a, b = pts[j], pts[j + 1]
+            if j in split and math.hypot(*(b - a)) > min_segment:
+                new.append(a + split[j] * (b - a))
+                added += 1
+            new.append(b)
+        if added == 0:
+            break
+        pts = np.array(new)
+    return SmoothingResult(None, max_rounds, len(pts) - n0, float("nan"))
