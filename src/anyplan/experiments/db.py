@@ -54,6 +54,7 @@ from anyplan.experiments.dbfile import (
     check_database,
     connect_readonly,
 )
+from anyplan.simulation.result import RunResult, RunStatus
 
 __all__ = [
     "ResultsDB",
@@ -77,7 +78,8 @@ STATUS: dict[int, str] = {
 }
 #: Our run outcome -> status value. ``error`` (the planner raised) is OMPL's "Crash";
 #: ``unreachable`` (the goal is proven out of reach before the run) is "Infeasible".
-STATUS_OF_OUTCOME = {"reached": 6, "timeout": 4, "collision": 10, "error": 7, "unreachable": 9}
+STATUS_OF_OUTCOME = {RunStatus.REACHED: 6, RunStatus.TIMEOUT: 4, RunStatus.COLLISION: 10, "error": 7,
+                     RunStatus.UNREACHABLE: 9}
 
 #: Run columns beyond experimentid/plannerid: (name, SQL type). OMPL's first, then ours.
 RUN_COLUMNS: list[tuple[str, str]] = [
@@ -121,11 +123,12 @@ def run_row(result: Mapping[str, Any] | None, *, run_index: int, seed: int, scen
                 "memory": None, "run_index": run_index, "seed": seed, "scenario_hash": scenario_hash,
                 "anyplan_version": __version__, "outcome": "error", "reached": 0, "collided": 0,
                 "wall_time": _fin(wall_time), "worker": worker, "error": error}
-    outcome = str(result.get("status", "timeout"))
-    reached = bool(result.get("reached_goal")) and outcome == "reached"
-    pts = np.asarray(result.get("planning_times_s") or [], dtype=float)
-    traj = result.get("trajectory") or [[0.0]]
-    length = _fin(result.get("path_length_m"))
+    res = RunResult.from_dict(result)
+    outcome = str(res.status)
+    reached = bool(res.reached_goal) and res.status == RunStatus.REACHED
+    pts = np.asarray(res.planning_times_s, dtype=float)
+    traj = res.trajectory or [[0.0]]
+    length = _fin(res.path_length_m)
     return {
         "status": STATUS_OF_OUTCOME.get(outcome, 0),
         "solved": int(reached), "approximate_solution": 0, "correct_solution": int(reached),
@@ -133,9 +136,9 @@ def run_row(result: Mapping[str, Any] | None, *, run_index: int, seed: int, scen
         "best_cost": length if reached else None, "solution_length": length if reached else None,
         "memory": None,
         "run_index": run_index, "seed": seed, "scenario_hash": scenario_hash,
-        "anyplan_version": str(result.get("anyplan_version", __version__)),
-        "outcome": outcome, "reached": int(reached), "collided": int(bool(result.get("collision"))),
-        "path_length": length, "time_to_goal": _fin(result.get("time_to_goal_s")),
+        "anyplan_version": str(res.anyplan_version),
+        "outcome": outcome, "reached": int(reached), "collided": int(bool(res.collision)),
+        "path_length": length, "time_to_goal": _fin(res.time_to_goal_s),
         "sim_time": _fin(traj[-1][0]),
         "planning_calls": int(pts.size),
         "planning_time_first": float(pts[0]) if pts.size else None,
@@ -143,21 +146,21 @@ def run_row(result: Mapping[str, Any] | None, *, run_index: int, seed: int, scen
         "planning_time_p95": float(np.percentile(pts, 95)) if pts.size else None,
         "planning_time_max": float(pts.max()) if pts.size else None,
         "planning_time_total": float(pts.sum()) if pts.size else 0.0,
-        "replans": int(result.get("replans") or 0),
-        "virtual_obstacles": len(result.get("virtual_obstacles") or []),
-        "plans": len(result.get("plans") or []),
-        "min_clearance": _fin(result.get("min_clearance_m")),
-        "collision_with": result.get("collision_with"),
-        "collision_time": _fin(result.get("collision_time_s")),
-        "wall_time": _fin(wall_time if wall_time is not None else result.get("wall_time_s")),
+        "replans": int(res.replans or 0),
+        "virtual_obstacles": len(res.virtual_obstacles),
+        "plans": len(res.plans),
+        "min_clearance": _fin(res.min_clearance_m),
+        "collision_with": res.collision_with,
+        "collision_time": _fin(res.collision_time_s),
+        "wall_time": _fin(wall_time if wall_time is not None else res.wall_time_s),
         "worker": worker, "error": error,
-        "robot_caused": (None if result.get("collision_robot_caused") is None
-                         else int(bool(result.get("collision_robot_caused")))),
-        "time_lower_bound": _fin(result.get("time_lower_bound_s")),
-        "time_over_lower_bound": _fin(result.get("time_over_lower_bound")),
-        "fallbacks": len((result.get("extra") or {}).get("fallbacks") or []),
-        "min_distance_to_moving": _fin(result.get("min_distance_to_moving_m")),
-        "discomfort_time": _fin(result.get("discomfort_time_s")),
+        "robot_caused": (None if res.collision_robot_caused is None
+                         else int(bool(res.collision_robot_caused))),
+        "time_lower_bound": _fin(res.time_lower_bound_s),
+        "time_over_lower_bound": _fin(res.time_over_lower_bound),
+        "fallbacks": len(res.extra.get("fallbacks") or []),
+        "min_distance_to_moving": _fin(res.min_distance_to_moving_m),
+        "discomfort_time": _fin(res.discomfort_time_s),
     }
 
 
@@ -193,9 +196,9 @@ def progress_rows(result: Mapping[str, Any]) -> list[tuple[float, float, int | N
             t = float(plan["t"])
         except (KeyError, TypeError, ValueError):
             continue
-        c = _polyline_length(plan.get("path"))
-        if c is not None and math.isfinite(t):
-            rows[t] = (t, c, i, "plans")
+        length = _polyline_length(plan.get("path"))
+        if length is not None and math.isfinite(t):
+            rows[t] = (t, length, i, "plans")
     return sorted(rows.values())
 
 
@@ -365,7 +368,7 @@ class ResultsDB:
              datetime.now(UTC).strftime("%Y-%m-%d %H:%M:%S"), str(key.seed), scenario_json,
              key.scenario_hash, moving_obstacles, suite, key.sim_dt))
         self.conn.commit()
-        return int(cur.lastrowid)
+        return int(cur.lastrowid or 0)
 
     def planner_id(self, name: str, settings: str) -> int:
         """The id of planner configuration (name, settings), created (and committed) if new."""
@@ -376,7 +379,7 @@ class ResultsDB:
         cur = self.conn.execute("INSERT INTO plannerConfigs (name, settings) VALUES (?, ?)",
                                 (name, settings))
         self.conn.commit()
-        return int(cur.lastrowid)
+        return int(cur.lastrowid or 0)
 
     def done_keys(self) -> set[tuple[int, int, int, int]]:
         """``(experimentid, plannerid, run_index, seed)`` of every stored run."""
@@ -400,7 +403,7 @@ class ResultsDB:
                 if old is None:
                     raise
                 return int(old[0])
-            runid = int(cur.lastrowid)
+            runid = int(cur.lastrowid or 0)
             if result is not None:
                 self.conn.executemany(
                     "INSERT OR REPLACE INTO progress (runid, time, best_cost, plan_index, source) "
@@ -425,6 +428,11 @@ class ResultsDB:
         if enc == "json":
             return json.loads(data)
         raise ValueError(f"run {runid}: unknown result encoding '{enc}'")
+
+    def run_result(self, runid: int) -> RunResult | None:
+        """The stored result of run ``runid`` as a :class:`RunResult` (None if not stored)."""
+        data = self.result(runid)
+        return None if data is None else RunResult.from_dict(data)
 
     def query(self, sql: str, params: tuple[Any, ...] = ()) -> list[dict[str, Any]]:
         """Rows of ``sql`` as dictionaries."""

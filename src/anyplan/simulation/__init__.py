@@ -1,5 +1,6 @@
 """Fixed-step simulation of the robot, the moving obstacles and an agent."""
 
-from anyplan.simulation.simulator import RunResult, SimConfig, simulate
+from anyplan.simulation.result import RunResult, RunStatus
+from anyplan.simulation.simulator import SimConfig, simulate
 
-__all__ = ["RunResult", "SimConfig", "simulate"]
+__all__ = ["RunResult", "RunStatus", "SimConfig", "simulate"]

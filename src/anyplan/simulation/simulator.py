@@ -22,12 +22,10 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass, field
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 
-from anyplan import __version__
 from anyplan.agents.base import Agent, AgentStats, Observation
 from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.geometry.moving import closest_approach_straight
@@ -43,13 +41,14 @@ from anyplan.simulation.contact import (
 from anyplan.simulation.feasibility import goal_unreachable
 from anyplan.simulation.metrics import moving_obstacle_metrics
 from anyplan.simulation.perception import Sensor, effective_sensing, observe_exact, with_tracking
+from anyplan.simulation.result import WALL_CLOCK_FIELDS, RunResult, RunStatus, without_wall_clock
 from anyplan.world.limits import MAX_SIM_STEPS, MAX_TIME_LIMIT_S, MIN_DT_S
 from anyplan.world.motion import Jump
 from anyplan.world.robot import Command, RobotState, step
 from anyplan.world.scenario import Scenario
 
-__all__ = ["SimConfig", "RunResult", "Simulation", "simulate", "observe", "WALL_CLOCK_FIELDS",
-           "without_wall_clock"]
+__all__ = ["SimConfig", "RunResult", "RunStatus", "Simulation", "simulate", "observe",
+           "WALL_CLOCK_FIELDS", "without_wall_clock"]
 
 
 @dataclass(frozen=True)
@@ -90,105 +89,6 @@ class SimConfig:
             raise ValueError(f"time limit {limit:g} s / dt {self.dt:g} s = {n} steps, more than "
                              f"the limit of {MAX_SIM_STEPS}")
         return n
-
-
-@dataclass
-class RunResult:
-    """The outcome of one simulated run (the ``result.json`` contract).
-
-    Lengths in m, times in s, angles in rad. ``trajectory`` rows are
-    ``[t, x, y, theta, v, omega]``, one per simulation step (the first at t = 0).
-
-    ``collision_robot_caused`` (None without a collision) tells whether, at the first contact,
-    the robot's velocity had a component of more than 0.05 m/s towards what it hit
-    (:mod:`anyplan.simulation.contact`); ``collision_approach_speed_mps`` is that component.
-    ``time_lower_bound_s`` is the least time from rest to the edge of the goal tolerance along
-    the static shortest path (:func:`anyplan.planning.time_bound.scenario_time_lower_bound`;
-    None without a path) and ``time_over_lower_bound`` the time to goal over it.
-
-    ``wall_clock_fields`` names the fields measured in wall-clock time (``wall_time_s``,
-    ``planning_times_s`` and the agent's ``extra.*`` timings): they differ from run to run and
-    machine to machine. Every other field is a function of the scenario, the planner settings
-    and the seed when the planner runs deterministically (``--deterministic``);
-    :meth:`reproducible_dict` leaves the wall-clock fields out.
-    """
-
-    scenario: str
-    planner: str
-    seed: int
-    reached_goal: bool
-    collision: bool
-    path_length_m: float
-    time_to_goal_s: float | None
-    planning_times_s: list[float]
-    replans: int
-    min_clearance_m: float
-    trajectory: list[list[float]]
-    status: str = "timeout"
-    collision_with: str | None = None
-    collision_time_s: float | None = None
-    virtual_obstacles: list[dict[str, Any]] = field(default_factory=list)
-    plans: list[dict[str, Any]] = field(default_factory=list)
-    scenario_hash: str = ""
-    dt_s: float = 0.05
-    wall_time_s: float = 0.0
-    anyplan_version: str = __version__
-    extra: dict[str, Any] = field(default_factory=dict)
-    collision_robot_caused: bool | None = None
-    collision_approach_speed_mps: float | None = None
-    time_lower_bound_s: float | None = None
-    time_over_lower_bound: float | None = None
-    #: Smallest robot-to-moving-obstacle surface distance [m] (None without moving obstacles)
-    #: and time [s] within 0.2 m of one (:mod:`anyplan.simulation.metrics`).
-    min_distance_to_moving_m: float | None = None
-    discomfort_time_s: float = 0.0
-    wall_clock_fields: list[str] = field(default_factory=lambda: list(WALL_CLOCK_FIELDS))
-
-    def to_dict(self) -> dict[str, Any]:
-        """A JSON-serialisable dictionary."""
-        return _jsonable(asdict(self))
-
-    def reproducible_dict(self) -> dict[str, Any]:
-        """:meth:`to_dict` without the wall-clock fields."""
-        return without_wall_clock(self.to_dict())
-
-    @property
-    def trajectory_array(self) -> np.ndarray:
-        """The trajectory as an array, shape (N, 6)."""
-        return np.asarray(self.trajectory, dtype=float).reshape(-1, 6)
-
-
-#: Fields of every result measured in wall-clock time.
-WALL_CLOCK_FIELDS = ("wall_time_s", "planning_times_s")
-
-
-def without_wall_clock(result: dict[str, Any]) -> dict[str, Any]:
-    """A ``result.json`` dictionary without the fields it lists in ``wall_clock_fields``."""
-    out = dict(result)
-    out["extra"] = dict(out.get("extra") or {})
-    for name in result.get("wall_clock_fields", WALL_CLOCK_FIELDS):
-        if name.startswith("extra."):
-            out["extra"].pop(name[len("extra."):], None)
-        else:
-            out.pop(name, None)
-    return out
-
-
-def _jsonable(obj: Any) -> Any:
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, np.floating | float):
-        x = float(obj)
-        return x if math.isfinite(x) else None
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    return obj
 
 
 def observe(scenario: Scenario, t: float, robot: RobotState,
@@ -279,15 +179,15 @@ class Simulation:
             self.done = True
 
     @property
-    def status(self) -> str:
+    def status(self) -> RunStatus:
         """``running``, ``collision``, ``reached``, ``timeout`` or ``unreachable``."""
         if self.unreachable:
-            return "unreachable"
+            return RunStatus.UNREACHABLE
         if self.collision_with is not None:
-            return "collision"
+            return RunStatus.COLLISION
         if self.reached:
-            return "reached"
-        return "timeout" if self.done else "running"
+            return RunStatus.REACHED
+        return RunStatus.TIMEOUT if self.done else RunStatus.RUNNING
 
     def observation(self) -> Observation:
         """What an agent sees now (call it once per step: a sensor may keep state)."""
@@ -365,10 +265,10 @@ class Simulation:
         st = AgentStats() if self.unreachable or stats is None else stats
         collided = self.collision_with is not None
         reached = self.reached
-        status = "collision" if collided else ("reached" if reached else "timeout")
-        if self.unreachable:
-            status = "unreachable"
+        status = (RunStatus.UNREACHABLE if self.unreachable else RunStatus.COLLISION if collided
+                  else RunStatus.REACHED if reached else RunStatus.TIMEOUT)
         bound = scenario_time_lower_bound(self.scenario)
+        near = moving_obstacle_metrics(self.scenario, np.asarray(self.trajectory))
         ttg = self.time_to_goal_s if reached else None
         return RunResult(
             scenario=self.scenario.name,
@@ -396,7 +296,8 @@ class Simulation:
             time_lower_bound_s=bound,
             time_over_lower_bound=(ttg / bound if ttg is not None and bound is not None and bound > 0.0
                                    else None),
-            **moving_obstacle_metrics(self.scenario, np.asarray(self.trajectory)),
+            min_distance_to_moving_m=near["min_distance_to_moving_m"],
+            discomfort_time_s=float(near["discomfort_time_s"] or 0.0),
         )
 
 
