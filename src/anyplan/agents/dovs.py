@@ -54,7 +54,7 @@ class DOVSAgent(Agent):
         base = config or DOVSConfig()
         unknown = sorted(set(overrides) - set(DOVSConfig.field_names()))
         if unknown:
-            raise DOVSConfigError(f"dovs: unknown parameter(s) {', '.join(unknown)} "
+            raise DOVSConfigError("", "dovs", f"unknown parameter(s) {', '.join(unknown)} "
                                   f"(known: {', '.join(DOVSConfig.field_names())})")
         self.base_config = replace(base, **overrides) if overrides else base
         self.use_robot_limits = use_robot_limits

@@ -5,7 +5,10 @@ is a scalar (``float``, ``int``, ``bool``, ``str``, ``None``, a union of those, 
 ``tuple[float, ...]``), plus the fields of the dataclasses named in its ``config_classes``
 attribute (for ``seq-bitstar``, :class:`~anyplan.planning.sequential.SequentialConfig`; for
 ``dovs``, :class:`~anyplan.baselines.dovs.config.DOVSConfig`): what it accepts as keywords through
-``**options``. This works for plugins too: their ``__init__`` signature is read the same way.
+``**options``; an entry of ``config_classes`` may be a config instance, whose values are then
+the agent's defaults. Config fields declared with :func:`anyplan.config.setting` are listed
+with their range, unit and description. This works for plugins too: their ``__init__`` signature
+is read the same way.
 
 ``VALUE`` is parsed as a YAML scalar (``0.1``, ``2``, ``true``, ``null``, ``measured``,
 ``[0.5, 1.0]``) and checked against the setting's type; an unknown key is refused with the
@@ -20,7 +23,6 @@ on the machine's speed. An agent class without that attribute has no such mode.
 
 from __future__ import annotations
 
-import dataclasses
 import inspect
 import types
 import typing
@@ -30,6 +32,7 @@ from typing import Any
 
 import yaml
 
+from anyplan.config import Spec, describe
 from anyplan.errors import AnyplanError, UnknownNameError
 
 __all__ = ["Setting", "SettingsError", "agent_settings", "parse_set_options", "build_agent_config",
@@ -44,16 +47,24 @@ class SettingsError(AnyplanError, ValueError):
 
 @dataclass(frozen=True)
 class Setting:
-    """One settable option: ``name``, its ``default`` and its type ``hint`` (None: unannotated)."""
+    """One settable option: ``name``, its ``default``, its type ``hint`` (None: unannotated) and,
+    for a field of a settings dataclass, its :class:`~anyplan.config.Spec` (range, unit, doc)."""
 
     name: str
     default: Any
     hint: Any
+    spec: Spec = Spec()
 
     @property
     def type_name(self) -> str:
         """The type in words, e.g. ``float or None``."""
         return _hint_name(self.hint)
+
+    def line(self) -> str:
+        """``name = default  (type, range, unit): doc``, one line of ``anyplan planners --settings``."""
+        extra = ", ".join(x for x in (self.type_name, self.spec.range_text(), self.spec.unit) if x)
+        doc = f": {self.spec.doc}" if self.spec.doc else ""
+        return f"{self.name} = {self.default!r}  ({extra}){doc}"
 
 
 def _hint_name(hint: Any) -> str:
@@ -113,14 +124,14 @@ def agent_settings(cls: type) -> dict[str, Setting]:
                 out[p.name] = Setting(p.name, None if p.default is p.empty else p.default, hint)
         if not forwards:
             break
+    # A config class, or a config instance whose values are the agent's defaults.
     for conf in getattr(cls, "config_classes", ()):
-        fh = _hints(conf)
-        for f in dataclasses.fields(conf):
-            hint = fh.get(f.name, inspect.Parameter.empty)
-            if f.name in out or not _settable(hint):
+        fh = _hints(conf if isinstance(conf, type) else type(conf))
+        for info in describe(conf):
+            hint = fh.get(info.name, inspect.Parameter.empty)
+            if info.name in out or not _settable(hint):
                 continue
-            default = f.default if f.default is not dataclasses.MISSING else None
-            out[f.name] = Setting(f.name, default, hint)
+            out[info.name] = Setting(info.name, info.default, hint, info.spec)
     return out
 
 
@@ -136,7 +147,10 @@ def _coerce(hint: Any, value: Any) -> Any:
     if origin in (typing.Union, types.UnionType):
         members = typing.get_args(hint)
         # Exact type matches first, so that "measured" stays a str and 2 stays an int.
-        for a in sorted(members, key=lambda a: 0 if isinstance(value, a if isinstance(a, type) else ()) else 1):
+        def exact_first(a: Any) -> int:
+            return 0 if isinstance(value, a if isinstance(a, type) else ()) else 1
+
+        for a in sorted(members, key=exact_first):
             try:
                 return _coerce(a, value)
             except TypeError:

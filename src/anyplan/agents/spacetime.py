@@ -106,6 +106,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     """
 
     name = "st-bitstar"
+    config_classes = (_DEFAULT_LOOP,)  # its defaults, for the listing of settings
 
     def __init__(self, config: SequentialConfig | None = None, *, patience_s: float = 3.0,
                  max_wait_s: float = 30.0, lattice_dt_s: float = 0.25, accept_s: float = 0.5,

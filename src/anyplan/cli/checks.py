@@ -6,7 +6,9 @@
   exists or can be made, the target is not a folder, and opening it for writing succeeds) before
   a simulation whose result would otherwise be lost;
 * :func:`safe_name` turns a name (a scenario's, a planner's) into one path component, so default
-  output paths derived from names stay under ``runs/``.
+  output paths derived from names stay under ``runs/``;
+* :func:`flag_message` reports a library error that names a settings field
+  (:class:`~anyplan.config.SettingError`) with the flag that sets the field.
 """
 
 from __future__ import annotations
@@ -18,12 +20,24 @@ import os
 import re
 from pathlib import Path
 
+from anyplan.config import SettingError
 from anyplan.errors import AnyplanError, one_line, shorten
 from anyplan.world import limits as L
 
 __all__ = ["seed", "time_limit", "sim_step", "positive_seconds", "count", "playback_speed",
            "writable_file", "writable_folder", "safe_name", "PLOT_SUFFIXES", "MAX_RUNS", "MAX_TASKS",
-           "MAX_JOBS", "MAX_PLAN_TIME_S", "SPEED_RANGE"]
+           "MAX_JOBS", "MAX_PLAN_TIME_S", "SPEED_RANGE", "SIM_FLAGS", "flag_message"]
+
+#: :class:`~anyplan.simulation.SimConfig` fields and the flags of ``run`` and ``bench`` that set them.
+SIM_FLAGS = {"dt": "--dt", "time_limit": "--time-limit"}
+
+
+def flag_message(exc: BaseException, flags: dict[str, str]) -> str:
+    """``exc`` as a command-line message: a :class:`~anyplan.config.SettingError` of a field in
+    ``flags`` is told with its flag (``--dt must be in [0.001, 0.05] s, got 0.5``)."""
+    if isinstance(exc, SettingError) and exc.field in flags:
+        return f"{flags[exc.field]} {exc.problem}"
+    return str(exc)
 
 #: Picture formats the plots can be written in (matplotlib's, without optional back ends).
 PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".svgz", ".jpg", ".jpeg", ".eps", ".ps", ".tif", ".tiff",

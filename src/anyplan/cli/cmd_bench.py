@@ -175,7 +175,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         for sc in scenarios:
             cfg.steps(sc.time_limit)
     except ValueError as exc:
-        raise _usage(f"bench: {exc}") from None
+        raise _usage(f"bench: {checks.flag_message(exc, checks.SIM_FLAGS)}") from None
     db_path = Path(args.db)
     if db_path.parent and not db_path.parent.exists():
         raise _usage(f"bench: --db {db_path}: folder {db_path.parent} does not exist")

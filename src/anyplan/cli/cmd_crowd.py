@@ -20,8 +20,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("file", help="obsmat file (frame person x z y vx vz vy per row)")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--name", default=None, help="scenario name prefix (default: from the file name)")
-    p.add_argument("--window", type=float, default=d.window_s, help=f"window length [s] (default {d.window_s:g})")
-    p.add_argument("--step", type=float, default=d.step_s, help=f"window start spacing [s] (default {d.step_s:g})")
+    p.add_argument("--window", type=float, default=d.window_s,
+                   help=f"window length [s] (default {d.window_s:g})")
+    p.add_argument("--step", type=float, default=d.step_s,
+                   help=f"window start spacing [s] (default {d.step_s:g})")
     p.add_argument("--copies", type=int, default=d.copies,
                    help="overlay this many time-shifted copies of the recording (denser crowds; default 1)")
     p.add_argument("--copy-shift", type=float, default=d.copy_shift_s,

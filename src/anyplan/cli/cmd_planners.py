@@ -34,5 +34,5 @@ def cmd_planners(args: argparse.Namespace) -> int:
         print(f"{name:18s} {AGENTS.origin(name)}: {doc}{det}")
         if args.settings:
             for s in agent_settings(cls).values():
-                print(f"    {s.name} = {s.default!r}  ({s.type_name})")
+                print(f"    {s.line()}")
     return 1 if broken else 0

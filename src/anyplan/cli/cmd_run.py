@@ -72,7 +72,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         cfg = SimConfig(dt=args.dt, time_limit=args.time_limit)
         cfg.steps(scenario.time_limit)
     except ValueError as exc:
-        raise UsageError(f"run: {exc}") from None
+        raise UsageError(f"run: {checks.flag_message(exc, checks.SIM_FLAGS)}") from None
     out = Path(args.out or f"runs/{checks.safe_name(scenario.name)}-"
                            f"{checks.safe_name(args.planner)}-{args.seed}")
     # Every output is proven writable before simulating, so no run is lost at the end.

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from anyplan.agents.base import Agent, AgentStats, Observation
+from anyplan.config import setting, validate
 from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.geometry.moving import closest_approach_straight
 from anyplan.planning.time_bound import scenario_time_lower_bound
@@ -66,20 +67,21 @@ class SimConfig:
             waypoint track and before a ``start_time``). Off turns a scenario's ``oracle``
             sensing into ``twist``; the scenario's ``sensing:`` block chooses the mode otherwise
             (:mod:`anyplan.simulation.perception`).
+        check_feasibility: Before the first step, end the run with status ``unreachable`` when
+            the visibility graph proves the goal out of reach.
+
+    Invalid values raise :class:`~anyplan.config.SettingError` naming the field (``SimConfig.dt``).
     """
 
-    dt: float = 0.05
-    time_limit: float | None = None
-    stop_on_collision: bool = True
-    announce_motions: bool = True
-    check_feasibility: bool = True
+    dt: float = setting(0.05, lo=MIN_DT_S, hi=0.05, unit="s", doc="step and control period")
+    time_limit: float | None = setting(None, lo=0.0, lo_open=True, hi=MAX_TIME_LIMIT_S, unit="s",
+                                       doc="simulated time limit; None: the scenario's")
+    stop_on_collision: bool = setting(True, doc="end the run at the first collision")
+    announce_motions: bool = setting(True, doc="observations carry the obstacles' motion models")
+    check_feasibility: bool = setting(True, doc="end at once when the goal is proven unreachable")
 
     def __post_init__(self) -> None:
-        if not MIN_DT_S <= self.dt <= 0.05:
-            raise ValueError(f"dt must be in [{MIN_DT_S:g}, 0.05] s, got {self.dt}")
-        if self.time_limit is not None and not 0.0 < self.time_limit <= MAX_TIME_LIMIT_S:
-            raise ValueError(f"time_limit must be in (0, {MAX_TIME_LIMIT_S:g}] s, "
-                             f"got {self.time_limit}")
+        validate(self)
 
     def steps(self, scenario_time_limit: float) -> int:
         """Number of simulation steps of a run (``ValueError`` beyond ``MAX_SIM_STEPS``)."""

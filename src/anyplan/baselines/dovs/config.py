@@ -5,11 +5,13 @@ Sources of the defaults:
 * Roy, Harchowdhury & Vachhani, "Anytime Planning: A Motion Planner for Dynamic Environment",
   Table 1 (the robot R: v = 0.4 m/s, omega = 0.4 rad/s, a_max = 0.4 m/s^2, alpha_max = 1 rad/s^2).
 * Lorente, Owen & Montano, "Model-based robocentric planning and navigation for dynamic
-  environments", IJRR 37(8), 2018, as described in ``shared/research/dovs.md`` (its §3.6 and §6.4
-  list the values used by the authors' public implementation: T = 0.2 s, safety factor 1.1,
-  braking margin 0.1 m, static-speed threshold 0.1 m/s, goal-switch distance 2 m, goal behind
-  beyond 3 pi / 4).
+  environments", IJRR 37(8), 2018, and the authors' public implementation (T = 0.2 s, safety
+  factor 1.1, braking margin 0.1 m, static-speed threshold 0.1 m/s, goal-switch distance 2 m,
+  goal behind beyond 3 pi / 4); see ``docs/dovs.md``.
 * Our own choices, marked "ours" below.
+
+Every field is declared with :func:`anyplan.config.setting` (range, choices, unit), checked by
+:func:`anyplan.config.validate` and listed by ``anyplan planners --settings``.
 """
 
 from __future__ import annotations
@@ -17,12 +19,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
-from anyplan.errors import AnyplanError
+from anyplan.config import SettingError, setting, validate
 
 __all__ = ["DOVSConfig", "DOVSConfigError"]
 
 
-class DOVSConfigError(AnyplanError, ValueError):
+class DOVSConfigError(SettingError):
     """A :class:`DOVSConfig` field has an invalid value (the message names the field)."""
 
 
@@ -81,55 +83,39 @@ class DOVSConfig:
             rotation in place (3 pi / 4, the authors' code).
     """
 
-    control_period_s: float = 0.2
-    v_max: float = 0.4
-    omega_max: float = 0.4
-    a_v: float = 0.4
-    a_omega: float = 1.0
-    robot_radius: float = 0.3
-    safety_factor: float = 1.1
-    time_horizon_s: float = 8.0
-    d_safe: float = 0.1
-    static_range: float | None = None
-    static_speed_threshold: float = 0.1
-    circular_omega_threshold: float = 1e-3
-    neighbourhood: float | None = None
-    merge: str = "hull"
-    velocity_space: str = "triangle"
-    window_shape: str = "diamond"
-    brake_along_ray: bool = True
-    dw_samples: int = 21
-    vs_samples: int = 100
-    goal_switch_distance: float = 2.0
-    goal_behind_angle: float = 3.0 * math.pi / 4.0
+    control_period_s: float = setting(0.2, lo=0.0, lo_open=True, unit="s", doc="sampling period T")
+    v_max: float = setting(0.4, lo=0.0, lo_open=True, unit="m/s", doc="maximum linear speed")
+    omega_max: float = setting(0.4, lo=0.0, lo_open=True, unit="rad/s", doc="maximum turn rate")
+    a_v: float = setting(0.4, lo=0.0, lo_open=True, unit="m/s^2", doc="linear acceleration limit")
+    a_omega: float = setting(1.0, lo=0.0, lo_open=True, unit="rad/s^2",
+                             doc="angular acceleration limit")
+    robot_radius: float = setting(0.3, lo=0.0, lo_open=True, unit="m", doc="robot disc radius")
+    safety_factor: float = setting(1.1, lo=1.0, doc="inflation of the robot radius")
+    time_horizon_s: float = setting(8.0, lo=0.0, lo_open=True, hi=600.0, unit="s",
+                                    doc="conflicts later than this are ignored")
+    d_safe: float = setting(0.1, lo=0.0, unit="m", doc="braking margin")
+    static_range: float | None = setting(None, lo=0.0, lo_open=True, unit="m",
+                                         doc="D_safe; None: the braking reach")
+    static_speed_threshold: float = setting(0.1, lo=0.0, unit="m/s",
+                                            doc="slower obstacles are static")
+    circular_omega_threshold: float = setting(1e-3, lo=0.0, unit="rad/s",
+                                              doc="faster-turning obstacles move on circles")
+    neighbourhood: float | None = setting(None, lo=0.0, lo_open=True, unit="m",
+                                          doc="model only obstacles this near; None: all")
+    merge: str = setting("hull", choices=("hull", "union"), doc="how DOVs on one ray combine")
+    velocity_space: str = setting("triangle", choices=("triangle", "rectangle"))
+    window_shape: str = setting("diamond", choices=("diamond", "box"))
+    brake_along_ray: bool = setting(True, doc="braking rule keeps the ray")
+    dw_samples: int = setting(21, lo=3, hi=1001, doc="dynamic-window grid per axis (odd)")
+    vs_samples: int = setting(100, lo=10, hi=1001, doc="velocity-space grid per axis")
+    goal_switch_distance: float = setting(2.0, lo=0.0, unit="m", doc="nearer: aim along the goal arc")
+    goal_behind_angle: float = setting(3.0 * math.pi / 4.0, lo=0.0, lo_open=True, hi=math.pi,
+                                       unit="rad", doc="a goal beyond this bearing is behind")
 
     def __post_init__(self) -> None:
-        positive = ("control_period_s", "v_max", "omega_max", "a_v", "a_omega", "robot_radius",
-                    "time_horizon_s")
-        for name in positive:
-            _check_number(self, name, lo=0.0, lo_open=True)
-        _check_number(self, "safety_factor", lo=1.0)
-        _check_number(self, "d_safe", lo=0.0)
-        _check_number(self, "static_speed_threshold", lo=0.0)
-        _check_number(self, "circular_omega_threshold", lo=0.0)
-        _check_number(self, "goal_switch_distance", lo=0.0)
-        _check_number(self, "goal_behind_angle", lo=0.0, lo_open=True, hi=math.pi)
-        if self.time_horizon_s > 600.0:
-            raise DOVSConfigError(f"DOVSConfig.time_horizon_s: must be <= 600 s, got {self.time_horizon_s}")
-        for name in ("static_range", "neighbourhood"):
-            if getattr(self, name) is not None:
-                _check_number(self, name, lo=0.0, lo_open=True)
-        _check_choice(self, "merge", ("hull", "union"))
-        _check_choice(self, "velocity_space", ("triangle", "rectangle"))
-        _check_choice(self, "window_shape", ("diamond", "box"))
-        if not isinstance(self.brake_along_ray, bool):
-            raise DOVSConfigError(f"DOVSConfig.brake_along_ray: must be a bool, got {self.brake_along_ray!r}")
-        for name, lo in (("dw_samples", 3), ("vs_samples", 10)):
-            val = getattr(self, name)
-            if isinstance(val, bool) or not isinstance(val, int) or val < lo or val > 1001:
-                raise DOVSConfigError(f"DOVSConfig.{name}: must be an integer in [{lo}, 1001], got {val!r}")
+        validate(self, DOVSConfigError)
         if self.dw_samples % 2 == 0:
-            raise DOVSConfigError(f"DOVSConfig.dw_samples: must be odd, got {self.dw_samples}")
+            raise DOVSConfigError("DOVSConfig", "dw_samples", f"must be odd, got {self.dw_samples}")
 
     # --- derived quantities ---------------------------------------------------------------
     @property
@@ -153,20 +139,3 @@ class DOVSConfig:
         """Names of all parameters."""
         return [f.name for f in fields(cls)]
 
-
-def _check_number(cfg: DOVSConfig, name: str, *, lo: float | None = None, lo_open: bool = False,
-                  hi: float | None = None) -> None:
-    val = getattr(cfg, name)
-    if isinstance(val, bool) or not isinstance(val, int | float) or not math.isfinite(val):
-        raise DOVSConfigError(f"DOVSConfig.{name}: must be a finite number, got {val!r}")
-    if lo is not None and (val < lo or (lo_open and val == lo)):
-        op = ">" if lo_open else ">="
-        raise DOVSConfigError(f"DOVSConfig.{name}: must be {op} {lo}, got {val}")
-    if hi is not None and val > hi:
-        raise DOVSConfigError(f"DOVSConfig.{name}: must be <= {hi}, got {val}")
-
-
-def _check_choice(cfg: DOVSConfig, name: str, choices: tuple[str, ...]) -> None:
-    val = getattr(cfg, name)
-    if val not in choices:
-        raise DOVSConfigError(f"DOVSConfig.{name}: must be one of {', '.join(choices)}, got {val!r}")

@@ -61,15 +61,22 @@ V_EPS = 1e-9
 
 
 class ObstacleLike(Protocol):
-    """What the model reads from an observed obstacle (world frame, SI units)."""
+    """What the model reads from an observed obstacle (world frame, SI units; read-only)."""
 
-    name: str
-    x: float
-    y: float
-    theta: float
-    v: float
-    omega: float
-    radius: float
+    @property
+    def name(self) -> str: ...
+    @property
+    def x(self) -> float: ...
+    @property
+    def y(self) -> float: ...
+    @property
+    def theta(self) -> float: ...
+    @property
+    def v(self) -> float: ...
+    @property
+    def omega(self) -> float: ...
+    @property
+    def radius(self) -> float: ...
 
 
 @dataclass(frozen=True)
@@ -528,7 +535,7 @@ class DOVSModel:
             los.append(lo)
             his.append(hi)
             owners.extend([i] * lo.shape[1])
-        if include_static and self.static_map is not None:
+        if include_static and self.static_map is not None and self.pose is not None:
             reach = cfg.d_safe + rays.v_max ** 2 / (2.0 * ray_deceleration(rays.kappa, cfg)) + 1e-6
             s_hit = self.static_map.first_contact(self.pose, rays.kappa, np.minimum(reach, rays.s_max))
             fin = np.isfinite(s_hit)
