@@ -100,7 +100,7 @@ def _truth(scenario):
 def _escape_free(traj, t, t_commit, spec, obstacles, preds):
     """Independent re-prediction: follow traj to t_commit, brake at a_max; exact predictor."""
     t_commit = min(max(t_commit, traj.t_start), traj.t_end)
-    st_c = RobotState(*traj.state(t_commit))
+    st_c = traj.state(t_commit)
     segs, t_rest, _, static_ok = brake_to_rest(st_c, spec, obstacles, spec.radius, t_commit)
     brake = segs[0] if segs else None
 

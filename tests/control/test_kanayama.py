@@ -24,8 +24,8 @@ def run(traj, state, spec=SPEC, dt=0.05, extra_time=3.0, controller=None):
     n = int(math.ceil((traj.t_end + extra_time - t) / dt))
     for i in range(n):
         t = traj.t_start + i * dt
-        x, y, _, _, _ = traj.state(t)
-        errs.append(math.hypot(x - state.x, y - state.y))
+        ref = traj.state(t)
+        errs.append(math.hypot(ref.x - state.x, ref.y - state.y))
         times.append(t)
         state = step(spec, state, ctl.command(traj, state, t), dt)
         states.append(state)
@@ -64,13 +64,12 @@ def test_on_reference_command_is_the_mean_feedforward():
     tr = plan_motion(path, SPEC, RobotState(1.0, 3.0, 0.3), obs, 0.0)
     ctl = KanayamaController(SPEC, dt=0.05)
     for t in (0.0, 3.0, 7.3, 12.0):
-        x, y, th, v, w = tr.state(t)
-        st = RobotState(x, y, th, v, w)
+        st = tr.state(t)
         cmd = ctl.command(tr, st, t)
         # one step with the command lands on the reference (to integration accuracy)
         nxt = step(SPEC, st, cmd, 0.05)
-        xr, yr, _, _, _ = tr.state(t + 0.05)
-        assert math.hypot(nxt.x - xr, nxt.y - yr) < 1e-4
+        ref = tr.state(t + 0.05)
+        assert math.hypot(nxt.x - ref.x, nxt.y - ref.y) < 1e-4
 
 
 def test_output_is_saturated():

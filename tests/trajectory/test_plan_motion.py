@@ -37,7 +37,10 @@ def test_sample_contract_and_hold_after_end():
     assert tr.path.shape[1] == 2
     assert np.allclose(tr.path[0], [1.5, 5.5]) and np.allclose(tr.path[-1], [13.5, 5.5])
     assert tr.length == pytest.approx(float(np.sum(np.hypot(*np.diff(tr.path, axis=0).T))), rel=1e-3)
-    assert isinstance(tr.state(5.0), tuple) and len(tr.state(5.0)) == 5
+    st = tr.state(5.0)
+    assert isinstance(st, RobotState)
+    xs, ys, ths, vs, ws = tr.sample(np.array([5.0]))
+    assert (st.x, st.y, st.theta, st.v, st.omega) == (xs[0], ys[0], ths[0], vs[0], ws[0])
 
 
 @pytest.mark.parametrize("shortcut", [True, False])

@@ -135,12 +135,12 @@ class BITStarAgent(Agent):
         traj = self.trajectory
         if traj is None:
             return Command(0.0, 0.0)
-        x, y, _, _, _ = traj.state(obs.t)
-        self.tracking.add((x, y), obs.robot, self.stats.extra)
+        ref = traj.state(obs.t)
+        self.tracking.add((ref.x, ref.y), obs.robot, self.stats.extra)
         return self.controller.command(traj, obs.robot, obs.t)
 
     def reference_state(self, t: float) -> RobotState | None:
         """The reference state at time ``t`` [s], or None before planning."""
         if self.trajectory is None:
             return None
-        return RobotState(*self.trajectory.state(t))
+        return self.trajectory.state(t)

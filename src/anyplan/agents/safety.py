@@ -131,7 +131,7 @@ class Escape:
                  radius: float) -> None:
         self.motion = motion
         self.t_commit = float(min(max(t_commit, motion.t_start), motion.t_end))
-        st = RobotState(*motion.state(self.t_commit))
+        st = motion.state(self.t_commit)
         segs, t_rest, _, free = brake_to_rest(st, spec, obstacles, radius, self.t_commit)
         self.brake: BrakeSegment | None = segs[0] if segs else None  # type: ignore[assignment]
         self.t_rest = float(t_rest)

@@ -194,7 +194,7 @@ class SequentialBITStarAgent(Agent):
         if self.trajectory is None:
             r = obs.robot
             return RobotState(r.x, r.y, r.theta, 0.0, 0.0)
-        return RobotState(*self.trajectory.state(t))
+        return self.trajectory.state(t)
 
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
         dt = self._dt or 0.05
@@ -307,8 +307,8 @@ class SequentialBITStarAgent(Agent):
         traj = self.trajectory
         if traj is None:
             return Command(0.0, 0.0)
-        x, y, _, _, _ = traj.state(t)
-        self.tracking.add((x, y), obs.robot, self.stats.extra)
+        ref = traj.state(t)
+        self.tracking.add((ref.x, ref.y), obs.robot, self.stats.extra)
         return self.controller.command(traj, obs.robot, t)
 
     def request_replan(self, reason: str) -> None:

@@ -25,6 +25,7 @@ from anyplan.trajectory.profile import SpeedProfile
 from anyplan.trajectory.segment import Sample, Segment
 from anyplan.trajectory.spline import SmoothCurve
 from anyplan.trajectory.turn import TurnSegment
+from anyplan.world.robot import RobotState
 
 __all__ = ["Segment", "CurveSegment", "TurnSegment", "BrakeSegment", "Trajectory"]
 
@@ -185,13 +186,13 @@ class Trajectory:
         x, y, _, _, _ = self.sample(np.atleast_1d(np.asarray(t, dtype=float)))
         return np.column_stack([x.ravel(), y.ravel()])
 
-    def state(self, t: float) -> tuple[float, float, float, float, float]:
-        """(x, y, theta, v, omega) at absolute time ``t`` [s] as floats."""
-        vals = self.sample(np.array([float(t)]))
-        return tuple(float(v[0]) for v in vals)  # type: ignore[return-value]
+    def state(self, t: float) -> RobotState:
+        """The reference pose and twist at absolute time ``t`` [s]."""
+        x, y, th, v, w = self.sample(np.array([float(t)]))
+        return RobotState(float(x[0]), float(y[0]), float(th[0]), float(v[0]), float(w[0]))
 
     @property
     def end_pose(self) -> tuple[float, float, float]:
         """(x [m], y [m], theta [rad]) at the end."""
-        x, y, th, _, _ = self.state(self.t_end)
-        return x, y, th
+        st = self.state(self.t_end)
+        return st.x, st.y, st.theta
