@@ -24,7 +24,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "anyplan"
 
 #: Tier of each top-level part of ``anyplan``; a module may import its own tier and lower ones.
 TIERS: dict[str, int] = {
-    "__init__": 0, "errors": 0, "registry": 0, "scenarios": 0,
+    "__init__": 0, "errors": 0, "config": 0, "registry": 0, "scenarios": 0,
     "geometry": 1,
     "world": 2,
     "planning": 3, "prediction": 3,
@@ -108,7 +108,7 @@ def _violations() -> list[tuple[str, str, str]]:
             if dotted[0] != "anyplan":
                 continue
             theirs = _part(dotted)
-            if theirs in TIERS and TIERS[theirs] > TIERS[mine]:
+            if theirs in TIERS and mine in TIERS and TIERS[theirs] > TIERS[mine]:
                 found.append((f"{where}:{line}", name, f"{mine} (tier {TIERS[mine]}) imports a "
                                                        f"later layer, {theirs} (tier {TIERS[theirs]})"))
             owner = _private_owner(dotted)
