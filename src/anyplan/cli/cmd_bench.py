@@ -185,9 +185,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
         checks.writable_folder(args.out, "bench: --out")
     try:
         summary = run_bench(scenarios, planners, args.runs, db_path, master_seed=args.seed,
-                            jobs=args.jobs, dt=args.dt, time_limit=args.time_limit,
-                            resume=args.resume, scheduler=args.scheduler, suite=args.suite,
-                            progress=not args.no_progress)
+                            jobs=args.jobs, resume=args.resume, scheduler=args.scheduler,
+                            suite=args.suite, progress=not args.no_progress, sim=cfg)
     except BenchInterrupted as exc:
         sys.stderr.write(f"anyplan: bench stopped: {exc}\n")
         return 1

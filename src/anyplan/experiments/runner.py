@@ -1,10 +1,12 @@
 """The benchmark runner: every (scenario, planner, run) in parallel, results into the database.
 
-Work is split into :class:`RunTask` objects (plain, picklable data: the scenario as a
-dictionary, the planner's registry name and config, the seed). A task is executed by the
-top-level function :func:`execute_task`, which is safe for ``spawn`` worker processes and Dask
-workers alike: it rebuilds the scenario and the agent inside the worker and returns the whole
-``result.json`` dictionary (or the planner's error). Only the coordinating process writes the
+Work is split into :class:`RunTask` objects (picklable: the validated scenario, its content
+hash, the validated :class:`~anyplan.simulation.SimConfig`, the planner's registry name and
+config, the seed). Settings are validated once, at the edge: the scenario when it is loaded and
+the simulation settings in :func:`run_bench`; a worker neither re-parses nor re-hashes them. A
+task is executed by the top-level function :func:`execute_task`, which is safe for ``spawn``
+worker processes and Dask workers alike: it builds the agent inside the worker and returns the
+whole ``result.json`` dictionary (or the planner's error). Only the coordinating process writes the
 database, one committed transaction per finished run, so Ctrl-C, a killed worker or a crash of
 the coordinator loses no finished run, and ``resume=True`` runs only the missing ones.
 
@@ -27,7 +29,7 @@ import sys
 import time
 import traceback
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -38,7 +40,7 @@ from anyplan.errors import AnyplanError
 from anyplan.experiments.db import ExperimentKey, ResultsDB, run_row, settings_string
 from anyplan.experiments.progress import ProgressBar
 from anyplan.simulation.simulator import SimConfig, simulate
-from anyplan.world.scenario import Scenario, scenario_from_dict
+from anyplan.world.scenario import Scenario
 
 __all__ = ["PlannerSpec", "RunTask", "BenchError", "BenchInterrupted", "BenchSummary", "derive_seed",
            "execute_task", "plan_tasks", "run_bench", "parse_planners"]
@@ -120,9 +122,9 @@ def derive_seed(master_seed: int, run_index: int) -> int:
 
 @dataclass(frozen=True)
 class RunTask:
-    """One simulated run, as plain data that pickles cheaply to a worker."""
+    """One simulated run, as validated objects that pickle to a worker."""
 
-    scenario_data: dict[str, Any]
+    scenario: Scenario
     scenario_name: str
     scenario_hash: str
     planner: str
@@ -130,8 +132,7 @@ class RunTask:
     planner_entry: str | None
     run_index: int
     seed: int
-    dt: float
-    time_limit: float | None
+    sim: SimConfig
     experimentid: int = -1
     plannerid: int = -1
 
@@ -155,10 +156,8 @@ def execute_task(task: RunTask) -> dict[str, Any]:
     try:
         if task.planner not in AGENTS and task.planner_entry:
             AGENTS.register(task.planner, task.planner_entry)
-        scenario = scenario_from_dict(task.scenario_data, f"<bench {task.scenario_name}>")
         agent = make_agent(task.planner, **task.planner_config)
-        cfg = SimConfig(dt=task.dt, time_limit=task.time_limit)
-        result = simulate(scenario, agent, seed=task.seed, config=cfg).to_dict()
+        result = simulate(task.scenario, agent, seed=task.seed, config=task.sim).to_dict()
         if result.get("planner") != task.planner:  # agents may set a different .name
             result["agent_name"] = result.get("planner")
             result["planner"] = task.planner
@@ -183,22 +182,31 @@ def _planner_entry(name: str) -> str | None:
 
 
 def plan_tasks(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], runs: int,
-               master_seed: int, dt: float = 0.05, time_limit: float | None = None) -> list[RunTask]:
-    """All tasks, ordered run-major so that partial results cover every planner and scenario."""
+               master_seed: int, dt: float = 0.05, time_limit: float | None = None,
+               sim: SimConfig | None = None) -> list[RunTask]:
+    """All tasks, ordered run-major so that partial results cover every planner and scenario;
+    ``sim`` (if given) replaces ``dt`` and ``time_limit``."""
     if runs < 1:
         raise BenchError(f"--runs must be >= 1, got {runs}")
+    sim = sim if sim is not None else _sim_config(dt, time_limit)
     entries = {p.name: _planner_entry(p.name) for p in planners}
     for p in planners:
         check_planner_config(p)
-    data = [(sc, sc.to_dict(), sc.content_hash()) for sc in scenarios]
     tasks = []
     for i in range(runs):
         seed = derive_seed(master_seed, i)
-        for sc, d, h in data:
+        for sc in scenarios:
             for p in planners:
-                tasks.append(RunTask(d, sc.name, h, p.name, dict(p.config), entries[p.name], i, seed,
-                                     dt, time_limit))
+                tasks.append(RunTask(sc, sc.name, sc.content_hash(), p.name, dict(p.config),
+                                     entries[p.name], i, seed, sim))
     return tasks
+
+
+def _sim_config(dt: float, time_limit: float | None) -> SimConfig:
+    try:
+        return SimConfig(dt=dt, time_limit=time_limit)
+    except ValueError as exc:
+        raise BenchError(str(exc)) from None
 
 
 @dataclass
@@ -281,7 +289,8 @@ def _dask(tasks: Sequence[RunTask], scheduler: Any) -> Iterator[tuple[RunTask, d
 def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], runs: int,
               db_path: str | Path, *, master_seed: int = 0, jobs: int = 1, dt: float = 0.05,
               time_limit: float | None = None, resume: bool = False, scheduler: Any = None,
-              suite: str = "", progress: bool = True, stream: TextIO | None = None) -> BenchSummary:
+              suite: str = "", progress: bool = True, stream: TextIO | None = None,
+              sim: SimConfig | None = None) -> BenchSummary:
     """Run every (scenario, planner, run) and store each finished run at once.
 
     Args:
@@ -299,6 +308,7 @@ def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], ru
         suite: The suite's name, recorded in ``experiments.suite``.
         progress: Show a progress bar on ``stream``.
         stream: Where progress and notices go (default stderr).
+        sim: Validated simulation settings; replaces ``dt`` and ``time_limit`` when given.
 
     Raises:
         BenchError: bad input, or runs already present without ``resume``.
@@ -308,11 +318,9 @@ def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], ru
     stream = stream if stream is not None else sys.stderr
     if jobs < 1:
         raise BenchError(f"--jobs must be >= 1, got {jobs}")
-    try:
-        SimConfig(dt=dt, time_limit=time_limit)
-    except ValueError as exc:
-        raise BenchError(str(exc)) from None
-    all_tasks = plan_tasks(scenarios, planners, runs, master_seed, dt, time_limit)
+    sim = sim if sim is not None else _sim_config(dt, time_limit)
+    dt, time_limit = sim.dt, sim.time_limit
+    all_tasks = plan_tasks(scenarios, planners, runs, master_seed, sim=sim)
     summary = BenchSummary(planned=len(all_tasks))
     t_start = time.perf_counter()
     with ResultsDB(db_path) as db:
@@ -328,7 +336,7 @@ def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], ru
         done = db.done_keys()
         tasks = []
         for t in all_tasks:
-            t2 = RunTask(**{**t.__dict__, "experimentid": exp_ids[t.scenario_hash],
+            t2 = replace(t, **{"experimentid": exp_ids[t.scenario_hash],
                             "plannerid": plan_ids[(t.planner, settings_string(t.planner_config))]})
             if (t2.experimentid, t2.plannerid, t2.run_index, t2.seed) in done:
                 summary.skipped += 1

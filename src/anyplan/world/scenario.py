@@ -92,11 +92,18 @@ class Scenario:
 
     def obstacle_set(self) -> ObstacleSet:
         """The static obstacles, the map's blocked cells (merged into boxes) and the arena
-        walls, for exact clearance queries (with a map, built once and cached by the map)."""
-        shapes = [o.shape for o in self.static_obstacles]
-        if self.static_map is None:
-            return ObstacleSet(shapes, bounds=self.bounds)
-        return self.static_map.obstacle_set(shapes, self.bounds)
+        walls, for exact clearance queries: built once per scenario and cached on it (shared by
+        :meth:`static_only`; not pickled, a worker builds its own once)."""
+        cached = self.__dict__.get("_obstacle_set")
+        if cached is None:
+            shapes = [o.shape for o in self.static_obstacles]
+            cached = (ObstacleSet(shapes, bounds=self.bounds) if self.static_map is None
+                      else self.static_map.obstacle_set(shapes, self.bounds))
+            self.__dict__["_obstacle_set"] = cached  # a frozen dataclass: a cache, not a field
+        return cached
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {k: v for k, v in self.__dict__.items() if k != "_obstacle_set"}
 
     def nearest_static(self, a: Sequence[float] | np.ndarray,
                        b: Sequence[float] | np.ndarray | None = None) -> str:
@@ -118,7 +125,10 @@ class Scenario:
 
     def static_only(self) -> Scenario:
         """The same scenario without its moving obstacles (what a static planner knows)."""
-        return replace(self, moving_obstacles=())
+        out = replace(self, moving_obstacles=())
+        if "_obstacle_set" in self.__dict__:
+            out.__dict__["_obstacle_set"] = self.__dict__["_obstacle_set"]
+        return out
 
     def to_dict(self) -> dict[str, Any]:
         """The scenario as a dictionary of the YAML schema (round-trips through the loader)."""
@@ -147,12 +157,16 @@ class Scenario:
         return _plain(out)
 
     def content_hash(self) -> str:
-        """SHA-256 (hex, 16 chars) of the scenario's canonical JSON, ignoring its source."""
-        d = self.to_dict()
-        if self.static_map is not None:
-            d["static_map"] = self.static_map.digest()  # the content, not where it lives
-        blob = json.dumps(d, sort_keys=True, default=float).encode()
-        return hashlib.sha256(blob).hexdigest()[:16]
+        """SHA-256 (hex, 16 chars) of the scenario's canonical JSON, ignoring its source;
+        computed once per scenario and cached on it."""
+        cached = self.__dict__.get("_content_hash")
+        if cached is None:
+            d = self.to_dict()
+            if self.static_map is not None:
+                d["static_map"] = self.static_map.digest()  # the content, not where it lives
+            blob = json.dumps(d, sort_keys=True, default=float).encode()
+            cached = self.__dict__["_content_hash"] = hashlib.sha256(blob).hexdigest()[:16]
+        return str(cached)
 
 
 def _plain(obj: Any) -> Any:
