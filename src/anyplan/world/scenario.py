@@ -8,12 +8,10 @@ nearest known key suggested for a misspelling.
 
 from __future__ import annotations
 
-import difflib
 import hashlib
 import json
-import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -21,13 +19,22 @@ from typing import Any
 import numpy as np
 import yaml
 
-from anyplan.errors import ScenarioError, UnknownNameError, shorten
+from anyplan.errors import ScenarioError, UnknownNameError
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
-from anyplan.geometry.shapes import Circle, Polygon, Shape, rectangle
 from anyplan.world import limits as L
-from anyplan.world.motion import Motion, TrackMotion, UnicycleMotion, WaypointMotion
 from anyplan.world.occupancy import OccupancyMap, load_map
 from anyplan.world.robot import RobotSpec
+from anyplan.world.schema import (
+    MOTION_TYPES,
+    OBSTACLE_TYPES,
+    Ctx,
+    MovingObstacle,
+    StaticObstacle,
+    parse_moving,
+    parse_sensing,
+    parse_static,
+    typename,
+)
 from anyplan.world.sensing import SensingSpec
 from anyplan.world.yaml_load import YamlLimitError, load_yaml
 
@@ -38,30 +45,9 @@ __all__ = [
     "load_scenario",
     "scenario_from_dict",
     "builtin_scenarios",
+    "OBSTACLE_TYPES",
+    "MOTION_TYPES",
 ]
-
-
-@dataclass(frozen=True)
-class StaticObstacle:
-    """A named static shape."""
-
-    name: str
-    shape: Shape
-    spec: Mapping[str, Any] = field(compare=False, repr=False, default_factory=dict)
-
-
-@dataclass(frozen=True)
-class MovingObstacle:
-    """A named disc of ``radius`` [m] following ``motion``."""
-
-    name: str
-    radius: float
-    motion: Motion
-    spec: Mapping[str, Any] = field(compare=False, repr=False, default_factory=dict)
-
-    def position(self, t: float) -> np.ndarray:
-        """Centre [m] at time ``t`` [s], shape (2,)."""
-        return self.motion.position(t)
 
 
 @dataclass(frozen=True)
@@ -184,224 +170,8 @@ def _plain(obj: Any) -> Any:
     return obj
 
 
-# --------------------------------------------------------------------------------------------
-# Validation helpers
-# --------------------------------------------------------------------------------------------
-class _Ctx:
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, fld: str, msg: str) -> ScenarioError:
-        return ScenarioError(self.source, fld, msg)
-
-    def mapping(self, obj: Any, fld: str) -> Mapping[str, Any]:
-        if not isinstance(obj, Mapping):
-            raise self.fail(fld, f"expected a mapping, got {_typename(obj)}")
-        return obj
-
-    def keys(self, obj: Mapping[str, Any], fld: str, required: Sequence[str],
-             optional: Sequence[str] = ()) -> None:
-        known = list(required) + list(optional)
-        for key in obj:
-            if key not in known:
-                close = difflib.get_close_matches(str(key), known, n=1)
-                hint = f"; did you mean '{close[0]}'?" if close else ""
-                raise self.fail(_join(fld, shorten(key, 40).strip("'")),
-                                f"unknown key{hint} (known: {', '.join(known)})")
-        for key in required:
-            if key not in obj:
-                raise self.fail(_join(fld, key), "missing required key")
-
-    def number(self, obj: Any, fld: str, *, positive: bool = False, nonneg: bool = False,
-               lo: float | None = None, hi: float | None = None) -> float:
-        """A finite number; ``lo``/``hi`` are the stated limits (inclusive), ``hi`` also
-        bounds the magnitude when ``lo`` is None."""
-        if isinstance(obj, bool) or not isinstance(obj, int | float):
-            raise self.fail(fld, f"expected a number, got {_typename(obj)}")
-        try:
-            x = float(obj)
-        except OverflowError:
-            raise self.fail(fld, "number too large (beyond the floating-point range)") from None
-        if not math.isfinite(x):
-            raise self.fail(fld, f"must be finite, got {x}")
-        if positive and not x > 0.0:
-            raise self.fail(fld, f"must be > 0, got {x:g}")
-        if nonneg and x < 0.0:
-            raise self.fail(fld, f"must be >= 0, got {x:g}")
-        if lo is not None and x < lo:
-            raise self.fail(fld, f"must be >= {lo:g} (the stated limit), got {x:g}")
-        if hi is not None and (x > hi or (lo is None and x < -hi)):
-            bound = f"<= {hi:g}" if lo is not None or positive or nonneg else f"within +-{hi:g}"
-            raise self.fail(fld, f"must be {bound} (the stated limit), got {x:g}")
-        return x
-
-    def vector(self, obj: Any, fld: str, n: int, hi: float = L.MAX_COORD_M) -> tuple[float, ...]:
-        if not isinstance(obj, list | tuple) or len(obj) != n:
-            raise self.fail(fld, f"expected a list of {n} numbers, got {_short(obj)}")
-        return tuple(self.number(v, f"{fld}[{i}]", hi=hi) for i, v in enumerate(obj))
-
-    def string(self, obj: Any, fld: str) -> str:
-        if not isinstance(obj, str) or not obj:
-            raise self.fail(fld, f"expected a non-empty string, got {_typename(obj)}")
-        if len(obj) > L.MAX_TEXT_CHARS:
-            raise self.fail(fld, f"longer than {L.MAX_TEXT_CHARS} characters")
-        return obj
-
-    def items(self, obj: Any, fld: str, most: int) -> list[Any]:
-        """A list (None or a missing key: empty) of at most ``most`` items."""
-        if obj is None:
-            return []
-        if not isinstance(obj, list):
-            raise self.fail(fld, f"expected a list, got {_typename(obj)}")
-        if len(obj) > most:
-            raise self.fail(fld, f"more than {most} items (the stated limit), got {len(obj)}")
-        return obj
-
-
-def _join(a: str, b: str) -> str:
-    return f"{a}.{b}" if a else b
-
-
-def _typename(obj: Any) -> str:
-    return "nothing" if obj is None else type(obj).__name__
-
-
-def _short(obj: Any) -> str:
-    return shorten(obj, 40)
-
-
-# --------------------------------------------------------------------------------------------
-# Parsing
-# --------------------------------------------------------------------------------------------
 _ROBOT_REQUIRED = ("start", "goal", "radius", "v_max", "omega_max", "a_max", "alpha_max")
 _ROBOT_OPTIONAL = ("goal_tolerance", "sensing_range")
-
-
-def _parse_static(c: _Ctx, obj: Any, fld: str, index: int) -> StaticObstacle:
-    m = c.mapping(obj, fld)
-    if "type" not in m:
-        raise c.fail(_join(fld, "type"), "missing required key (rectangle, circle or polygon)")
-    kind = m["type"]
-    name = c.string(m.get("name", f"S{index + 1}"), _join(fld, "name"))
-    shape: Shape
-    try:
-        if kind == "rectangle":
-            c.keys(m, fld, ("type", "center", "size"), ("name", "angle"))
-            center = c.vector(m["center"], _join(fld, "center"), 2)
-            size = c.vector(m["size"], _join(fld, "size"), 2, hi=L.MAX_SIZE_M)
-            for i, s in enumerate(size):
-                if not s > 0.0:
-                    raise c.fail(f"{_join(fld, 'size')}[{i}]", f"must be > 0, got {s:g}")
-            angle = c.number(m.get("angle", 0.0), _join(fld, "angle"), hi=L.MAX_ANGLE_RAD)
-            shape = rectangle(center, size, angle)
-        elif kind == "circle":
-            c.keys(m, fld, ("type", "center", "radius"), ("name",))
-            center = c.vector(m["center"], _join(fld, "center"), 2)
-            shape = Circle(center, c.number(m["radius"], _join(fld, "radius"), positive=True,
-                                            hi=L.MAX_SIZE_M))
-        elif kind == "polygon":
-            c.keys(m, fld, ("type", "points"), ("name",))
-            pts = m["points"]
-            if not isinstance(pts, list) or len(pts) < 3:
-                raise c.fail(_join(fld, "points"), "expected a list of at least 3 [x, y] points")
-            c.items(pts, _join(fld, "points"), L.MAX_POLYGON_POINTS)
-            verts = [c.vector(p, f"{_join(fld, 'points')}[{i}]", 2) for i, p in enumerate(pts)]
-            shape = Polygon(np.array(verts))
-        else:
-            close = difflib.get_close_matches(str(kind), ["rectangle", "circle", "polygon"], n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            raise c.fail(_join(fld, "type"),
-                         f"unknown obstacle type '{kind}'{hint} (known: rectangle, circle, polygon)")
-    except ScenarioError:
-        raise
-    except ValueError as exc:  # geometric validation of the shape itself
-        raise c.fail(fld, str(exc)) from None
-    spec = dict(m)
-    spec["name"] = name
-    return StaticObstacle(name, shape, spec)
-
-
-def _parse_moving(c: _Ctx, obj: Any, fld: str, index: int) -> MovingObstacle:
-    m = c.mapping(obj, fld)
-    kind = m.get("type", "unicycle")
-    name = c.string(m.get("name", f"D{index + 1}"), _join(fld, "name"))
-    motion: Motion
-    if kind == "unicycle":
-        c.keys(m, fld, ("start", "v", "radius"), ("name", "type", "omega", "start_time"))
-        x0, y0, th0 = c.vector(m["start"], _join(fld, "start"), 3)
-        if abs(th0) > L.MAX_ANGLE_RAD:
-            c.number(th0, f"{_join(fld, 'start')}[2]", hi=L.MAX_ANGLE_RAD)
-        v = c.number(m["v"], _join(fld, "v"), hi=L.MAX_OBSTACLE_SPEED)
-        omega = c.number(m.get("omega", 0.0), _join(fld, "omega"), hi=L.MAX_OBSTACLE_TURN_RATE)
-        t0 = c.number(m.get("start_time", 0.0), _join(fld, "start_time"), nonneg=True,
-                      hi=L.MAX_EVENT_TIME_S)
-        motion = UnicycleMotion(x0, y0, th0, v, omega, t0)
-    elif kind == "waypoints":
-        c.keys(m, fld, ("type", "keyframes", "radius"), ("name",))
-        kf = m["keyframes"]
-        if not isinstance(kf, list) or len(kf) < 2:
-            raise c.fail(_join(fld, "keyframes"), "expected a list of at least 2 [t, x, y] rows")
-        c.items(kf, _join(fld, "keyframes"), L.MAX_KEYFRAMES)
-        rows = [c.vector(r, f"{_join(fld, 'keyframes')}[{i}]", 3, hi=L.MAX_EVENT_TIME_S)
-                for i, r in enumerate(kf)]
-        _check_rows(c, rows, _join(fld, "keyframes"))
-        try:
-            motion = WaypointMotion(np.array(rows))
-            speed = motion.max_speed
-        except (ValueError, FloatingPointError) as exc:
-            raise c.fail(_join(fld, "keyframes"), str(exc)) from None
-        if not speed <= L.MAX_OBSTACLE_SPEED:
-            raise c.fail(_join(fld, "keyframes"), f"a segment is faster than "
-                         f"{L.MAX_OBSTACLE_SPEED:g} m/s (the stated limit)")
-    elif kind == "track":
-        motion = _parse_track(c, m, fld)
-    else:
-        close = difflib.get_close_matches(str(kind), ["unicycle", "waypoints", "track"], n=1)
-        hint = f"; did you mean '{close[0]}'?" if close else ""
-        raise c.fail(_join(fld, "type"),
-                     f"unknown motion type '{kind}'{hint} (known: unicycle, waypoints, track)")
-    radius = c.number(m["radius"], _join(fld, "radius"), positive=True, hi=L.MAX_SIZE_M)
-    spec = dict(m)
-    spec["name"] = name
-    return MovingObstacle(name, radius, motion, spec)
-
-
-def _check_rows(c: _Ctx, rows: list[tuple[float, ...]], fld: str) -> None:
-    """Rows (t, x, y): times in [0, MAX_EVENT_TIME_S], coordinates within +-MAX_COORD_M."""
-    for i, (t, x, y) in enumerate(rows):
-        c.number(t, f"{fld}[{i}][0]", nonneg=True, hi=L.MAX_EVENT_TIME_S)
-        c.number(x, f"{fld}[{i}][1]", hi=L.MAX_COORD_M)
-        c.number(y, f"{fld}[{i}][2]", hi=L.MAX_COORD_M)
-
-
-def _parse_track(c: _Ctx, m: Mapping[str, Any], fld: str) -> Motion:
-    c.keys(m, fld, ("type", "samples", "radius"), ("name",))
-    rows_raw = m["samples"]
-    if not isinstance(rows_raw, list) or len(rows_raw) < 2:
-        raise c.fail(_join(fld, "samples"), "expected a list of at least 2 [t, x, y] rows")
-    c.items(rows_raw, _join(fld, "samples"), L.MAX_KEYFRAMES)
-    rows = [c.vector(r, f"{_join(fld, 'samples')}[{i}]", 3, hi=L.MAX_EVENT_TIME_S)
-            for i, r in enumerate(rows_raw)]
-    _check_rows(c, rows, _join(fld, "samples"))
-    try:
-        return TrackMotion(np.array(rows))
-    except ValueError as exc:
-        raise c.fail(_join(fld, "samples"), str(exc)) from None
-
-
-def _parse_sensing(c: _Ctx, obj: Any) -> SensingSpec:
-    m = c.mapping(obj, "sensing")
-    c.keys(m, "sensing", ("mode",), ("noise_m", "rate_hz"))
-    mode = c.string(m["mode"], "sensing.mode")
-    noise = c.number(m.get("noise_m", SensingSpec.noise_m), "sensing.noise_m", nonneg=True,
-                     hi=L.MAX_SIZE_M)
-    rate = c.number(m.get("rate_hz", SensingSpec.rate_hz), "sensing.rate_hz", positive=True,
-                    hi=L.MAX_SENSOR_RATE_HZ)
-    try:
-        return SensingSpec(mode, noise, rate)
-    except ValueError as exc:
-        raise c.fail("sensing.mode", str(exc)) from None
-
 
 def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     """Build and validate a :class:`Scenario` from a dictionary of the YAML schema.
@@ -409,7 +179,7 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     Raises:
         ScenarioError: naming ``source`` and the offending field.
     """
-    c = _Ctx(source)
+    c = Ctx(source)
     top = c.mapping(data, "")
     c.keys(top, "", ("name", "robot"),
            ("arena", "description", "time_limit", "static_obstacles", "dynamic_obstacles",
@@ -419,7 +189,7 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     if description is None:
         description = ""
     if not isinstance(description, str):
-        raise c.fail("description", f"expected a string, got {_typename(description)}")
+        raise c.fail("description", f"expected a string, got {typename(description)}")
     if len(description) > L.MAX_TEXT_CHARS:
         raise c.fail("description", f"longer than {L.MAX_TEXT_CHARS} characters")
     time_limit = c.number(top.get("time_limit", 120.0), "time_limit", positive=True,
@@ -460,7 +230,7 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
                       goal_tolerance=goal_tol, sensing_range=sensing_range, **vals)
 
     statics_raw = c.items(top.get("static_obstacles"), "static_obstacles", L.MAX_STATIC_OBSTACLES)
-    statics = tuple(_parse_static(c, o, f"static_obstacles[{i}]", i)
+    statics = tuple(parse_static(c, o, f"static_obstacles[{i}]", i)
                     for i, o in enumerate(statics_raw))
     # The moving obstacles: "dynamic_obstacles" (the paper's word) or its alias "moving_obstacles".
     mkey = "moving_obstacles" if "moving_obstacles" in top else "dynamic_obstacles"
@@ -468,7 +238,7 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
         raise c.fail("moving_obstacles", "give the moving obstacles once: moving_obstacles is another "
                      "name for dynamic_obstacles")
     moving_raw = c.items(top.get(mkey), mkey, L.MAX_MOVING_OBSTACLES)
-    moving = tuple(_parse_moving(c, o, f"{mkey}[{i}]", i)
+    moving = tuple(parse_moving(c, o, f"{mkey}[{i}]", i)
                    for i, o in enumerate(moving_raw))
     names = [o.name for o in statics] + [o.name for o in moving]
     for i, n in enumerate(names):
@@ -478,12 +248,12 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     sc = Scenario(name=name, width=width, height=height, robot=robot, static_obstacles=statics,
                   moving_obstacles=moving, description=description, time_limit=time_limit,
                   source=source, origin=(ox, oy), static_map=smap,
-                  sensing=None if top.get("sensing") is None else _parse_sensing(c, top["sensing"]))
+                  sensing=None if top.get("sensing") is None else parse_sensing(c, top["sensing"]))
     _check_task(c, sc)
     return sc
 
 
-def _check_task(c: _Ctx, sc: Scenario) -> None:
+def _check_task(c: Ctx, sc: Scenario) -> None:
     r = sc.robot.radius
     obs = sc.obstacle_set()
     x0, y0, x1, y1 = sc.bounds
@@ -501,7 +271,7 @@ def _check_task(c: _Ctx, sc: Scenario) -> None:
                               f"robot radius {r:g}")
 
 
-def _static_map(c: _Ctx, obj: Any) -> OccupancyMap | None:
+def _static_map(c: Ctx, obj: Any) -> OccupancyMap | None:
     """The ``static_map`` key: a map_server YAML path, relative to the scenario file."""
     if obj is None:
         return None
