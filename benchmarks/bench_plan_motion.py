@@ -173,7 +173,7 @@ def main() -> None:
                 st_d.append(sd)
                 # Trajectory.sample: one time, and one Kanayama control step (5 times over 0.05 s),
                 # in the middle of the motion and at its start (braking or turning, if any)
-                kinds[tr_new.kind] = kinds.get(tr_new.kind, 0) + 1
+                kinds[str(tr_new.kind)] = kinds.get(str(tr_new.kind), 0) + 1
                 for t0 in (0.5 * tr_new.t_end, tr_new.t_start + 0.01):
                     t1 = np.array([t0])
                     t5 = t0 + 0.05 * np.linspace(0.0, 1.0, 5)

@@ -1,6 +1,11 @@
 """From path to motion: cubic-spline smoothing, speed profiles, turning in place, trajectories.
 
-The entry point is :func:`plan_motion` (polyline -> :class:`Trajectory`).
+The entry point is :func:`plan_motion` (polyline -> :class:`Trajectory`). One module per concept:
+``path`` (cleaning, shortcutting), ``spline`` (the curve, its certification and repair),
+``profile`` (speed profile), ``turn`` and ``brake`` (their segments), ``trajectory`` (the timed
+motion), ``kinds`` (string-valued enums of how motions are built), ``motion`` (the chain) and
+``spacetime`` (timing among moving obstacles); compiled kernels beside each concept.
+See ``docs/motion.md``.
 """
 
 from anyplan.trajectory.kinds import ST_PREFIX, MotionKind, SegmentKind

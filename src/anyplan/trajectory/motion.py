@@ -1,19 +1,15 @@
 """From a planned polyline to a timed reference motion: :func:`plan_motion`.
 
-The chain of the paper (§4): smooth the path with a cubic spline, repair it where it cuts an
-obstacle, generate the reference motion within the robot's limits, and, when the robot must take
-up a path whose direction differs from its heading, turn in place first. Candidates:
-
-* ``smooth``: drive off along a spline that starts with the robot's heading, speed and
-  curvature omega0 / v0 (so the reference turn rate starts at the robot's own);
-* ``turn+smooth`` (only if the heading differs): brake to rest if moving, turn in place toward
-  the path (:mod:`anyplan.trajectory.turn`), then drive a spline tangent to the first segment;
-* ``polyline`` (fallback when no spline can be certified collision-free): brake if moving, then
-  for each segment turn in place and drive straight from rest to rest.
-
-The fastest candidate that is collision-free (certified, see :mod:`anyplan.trajectory.spline`)
-and feasible from the current state wins, so the robot turns in place only when that beats the
-smooth start.
+The chain of the paper (Roy, Harchowdhury & Vachhani, §4): smooth the path with a cubic spline,
+repair it where it cuts an obstacle, generate the reference motion within the robot's limits,
+and turn in place first when that is faster. Candidates (:class:`~anyplan.trajectory.kinds.
+MotionKind`): ``smooth`` (a spline from the robot's heading, speed and curvature omega0 / v0),
+``turn+smooth`` / ``brake+turn+smooth`` (brake to rest if moving, turn in place toward the path,
+then a spline tangent to it) and ``polyline`` (when no spline can be certified: brake, then turn
+and drive straight, rest to rest, along each segment). The fastest candidate that is certified
+collision-free (:mod:`anyplan.trajectory.spline`) and feasible from the current state wins.
+Notation: v0, omega0 the robot's twist; times are absolute [s].
+See ``docs/motion.md`` ("``plan_motion`` and ``Trajectory``").
 """
 
 from __future__ import annotations

@@ -1,37 +1,15 @@
 """Time-optimal, acceleration-bounded velocity planning along a fixed path among s-t obstacles.
 
-The robot moves along a path of arc length ``s`` [m] (s in [0, L]); the moving obstacles forbid
-regions of the (s, t) plane. We look for the earliest time at which the robot can come to rest
-at the end of the path with
-
-* ``0 <= v <= v_max(s)`` (the speed limit curve of the path: v_max, omega_max / |kappa| and the
-  angular-acceleration limits, given per cell of the path as a cap on v^2);
-* ``|a| <= a_max``;
-* no point of its s-t curve inside a forbidden region;
-* waiting allowed anywhere (v = 0 stretches).
-
-This is the problem of Johnson & Hauser ("Optimal acceleration-bounded trajectory planning in
-dynamic environments along a specified path", ICRA 2012). They propagate exact reachable sets of
-(s, v) between obstacle boundaries. We solve it on an **exact bang-bang lattice** instead: time
-steps of ``dt`` with a constant acceleration in {-a, 0, +a} on each step. With ``v = k a dt`` and
-``s = s_A + m a dt^2 / 2``, one step maps integers (m, k) to (m + 2k + u, k + u), u in {-1, 0, 1},
-so the lattice is closed (no rounding). An A* search over the nodes (step n, m, k), with the
-obstacle-free time to go as heuristic (admissible), finds the earliest step at which (m_goal, 0)
-is reachable: the time-optimal motion among lattice motions,
-whose arrival is within a few ``dt`` of the continuous optimum (the continuous optimum can
-switch acceleration at any instant). Each step is checked *continuously*: its s(t) parabola is
-cut at the rows of the s-t map and every map cell it passes through must be free, and the
-speed limit must hold at the step's highest speed in every path cell it covers (on a step of
-constant acceleration v^2 is linear in s, so its maximum is at an end).
-
-The s-t map (``forbidden``) is a boolean grid: row j covers times [t_map + j h, t_map + (j+1) h],
-column c covers arc lengths [c ds, (c+1) ds]. A cell is forbidden when the robot anywhere in the
-cell could be in contact with an obstacle at any time of the row (see
-:mod:`anyplan.trajectory.spacetime.stmap`, which builds it conservatively), so a lattice motion
-that avoids every forbidden cell is collision-free.
-
-All kernels are numba (``cache=True``); the Python wrapper :func:`plan_velocity` handles a start
-speed that is not on the lattice (one first step at +-a to the nearest lattice speeds).
+The robot moves along a path of arc length s in [0, L]; moving obstacles forbid regions of the
+(s, t) plane (:mod:`~anyplan.trajectory.spacetime.stmap`). We look for the earliest arrival at
+rest at the end with 0 <= v <= v_max(s) (a cap on v^2 per path cell), |a| <= a_max, waits
+allowed, and no point of the s-t curve in a forbidden cell: the problem of Johnson & Hauser
+("Optimal acceleration-bounded trajectory planning in dynamic environments along a specified
+path", ICRA 2012), solved here on an exact bang-bang lattice: steps of ``dt`` at acceleration
+in {-a, 0, +a}, v = k a dt, s = s_A + m a dt^2 / 2, so a step maps integers (m, k) to
+(m + 2k + u, k + u); A* over (step n, m, k), each step checked continuously against the map.
+Kernels are numba; :func:`plan_velocity` handles a start speed off the lattice.
+Design and measurements: ``docs/spacetime.md`` ("Design: path-velocity decomposition ...").
 """
 
 from __future__ import annotations

@@ -1,24 +1,14 @@
 """The s-t obstacle map of a path: where and when the moving obstacles forbid the robot.
 
-For a path C(s) (arc length s in [0, L]) and predicted moving discs o_i(t) with radius r_i(t),
-the forbidden region of the (s, t) plane is ``{(s, t): |C(s) - o_i(t)| <= r + r_i(t) + margin}``.
-We cover it by a boolean grid of cells [c ds, (c+1) ds] x [t_map + j h, t_map + (j+1) h] and mark a
-cell forbidden when *some* point of the cell may be in that region:
-
-* every point of the path within the cell is within ds / 2 (along the curve, hence in the plane)
-  of the cell's centre point C((c + 1/2) ds);
-* over the row, the obstacle stays within ``max_speed * h / 2`` of its position at the row's
-  middle time, and its radius is at most the largest of its radii at the row's ends and middle
-  (exact for a radius that grows or shrinks monotonically, as a growing prediction does);
-
-so the cell is marked when ``|C(s_c) - o_i(t_mid)| <= r + r_i,max + margin + ds/2 + v_i h/2``.
-The map is therefore conservative: a motion that avoids every marked cell is collision-free
-with the true predicted discs (the planner still re-verifies the final timed motion with the
-certified continuous check before it is used).
-
-Predicted obstacles are :class:`~anyplan.prediction.PredictedObstacle` (constant radius) or any
-object with ``name``, ``positions(t)``, ``max_speed`` and either ``radius`` or a vectorised
-``radius_at(t)`` (absolute times [s] -> radii [m]): the radius of a prediction may grow with time.
+For a path C(s) (arc length s in [0, L]) and predicted moving discs o_i(t) of radius r_i(t), the
+forbidden region of the (s, t) plane is {(s, t): |C(s) - o_i(t)| <= r + r_i(t) + margin}. It is
+covered by a boolean grid of cells [c ds, (c+1) ds] x [t_map + j h, t_map + (j+1) h], a cell
+marked when |C(s_c) - o_i(t_mid)| <= r + r_i,max + margin + ds/2 + v_i h/2 (s_c, t_mid the cell's
+centre, r_i,max the largest radius at the row's ends and middle): conservative, so a motion
+that avoids every marked cell is collision-free with the predicted discs. Predictions are
+:class:`~anyplan.prediction.PredictedObstacle` or any object with ``name``, ``positions(t)``,
+``max_speed`` and ``radius`` or a vectorised ``radius_at(t)`` (a radius may grow with time).
+Derivation: ``docs/spacetime.md`` ("Design: path-velocity decomposition ...", step 4).
 """
 
 from __future__ import annotations
