@@ -29,7 +29,7 @@ def test_sample_contract_and_hold_after_end():
     assert tr.positions(t.ravel()).shape == (77, 2)
     np.testing.assert_allclose(tr.positions(np.array([2.0])), [[1.5, 5.5]], atol=1e-12)
     # before the start: held at the start pose
-    x, y, th, v, w = tr.sample(np.array([0.0, 2.0]))
+    x, y, th, _, _ = tr.sample(np.array([0.0, 2.0]))
     assert x[0] == x[1] and y[0] == y[1] and th[0] == th[1]
     xe, ye, _, ve, we = tr.sample(np.array([tr.t_end, tr.t_end + 100.0]))
     np.testing.assert_allclose([xe[0], ye[0]], [13.5, 5.5], atol=1e-9)
@@ -75,7 +75,7 @@ def test_start_while_moving(theta, limits_checker):
     path = np.array([[2.0, 3.0], [4.0, 4.3], [6.5, 4.3], [8.5, 3.0]])
     st = RobotState(2.0, 3.0, theta, 0.3, 0.1)
     tr = plan_motion(path, spec, st, obs, 10.0)
-    x, y, th, v, w = tr.sample(np.array([10.0]))
+    _, _, th, v, _ = tr.sample(np.array([10.0]))
     assert v[0] == pytest.approx(0.3)
     assert th[0] == pytest.approx(theta)
     assert tr.feasible

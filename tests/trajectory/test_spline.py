@@ -60,7 +60,7 @@ def test_two_points_give_a_straight_line():
 def test_clean_path_drops_duplicates_and_collinear_points():
     p = np.array([[0.0, 0.0], [0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 1.0]])
     np.testing.assert_allclose(clean_path(p), [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0]])
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="at least two points"):
         SmoothCurve(np.array([[0.0, 0.0]]))
 
 

@@ -57,7 +57,7 @@ def test_curve_queries_keep_shapes():
     assert c.position(1.0).shape == (2,)
     assert c.position(np.zeros((3, 4))).shape == (3, 4, 2)
     assert c.heading(np.zeros((3, 4))).shape == (3, 4)
-    k0, dk0 = c.curvature(np.array([0.0]))
+    k0, _ = c.curvature(np.array([0.0]))
     assert k0[0] == pytest.approx(0.5, abs=1e-9)
     assert c.u_of_s(np.zeros((2, 5))).shape == (2, 5)
 

@@ -58,7 +58,7 @@ def test_turn_chosen_when_facing_away(limits_checker):
     assert tr.duration == pytest.approx(min(c.values()))
     assert c["turn+smooth"] < c.get("smooth", math.inf)
     # the turn happens in place, then the robot drives the straight line
-    x, y, th, v, w = tr.sample(np.linspace(3.0, tr.segments[1].t0, 50))
+    x, y, _, v, _ = tr.sample(np.linspace(3.0, tr.segments[1].t0, 50))
     assert np.ptp(x) == 0.0 and np.ptp(y) == 0.0 and np.all(v == 0.0)
     assert tr.segments[1].t0 - 3.0 == pytest.approx(rest_to_rest_time(math.pi, 0.4, 1.0))
     limits_checker(tr, SPEC)

@@ -73,7 +73,6 @@ class BrakeSegment(Segment):
         self.t1 = self.t0 + dur
         n = max(2, math.ceil(dur / dt) + 1)
         self._tau = np.linspace(0.0, dur, n)
-        _, _, th, v, _ = self._twist(self._tau)
         # Midpoint-of-interval integration with the exact heading: error O(dt^2 * v * omega).
         tm = 0.5 * (self._tau[:-1] + self._tau[1:])
         _, _, thm, vm, _ = self._twist(tm)

@@ -229,11 +229,16 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
 
     Args:
         forbidden: s-t map (rows of ``h`` seconds from ``t_map``, columns of ``ds`` metres).
-        t_map, h, ds: Map origin [s], row duration [s], column width [m].
-        xcap0, xcap1: Cap on v^2 [m^2/s^2] per column when cruising / accelerating at +-a_max.
+        t_map: Map origin [s].
+        h: Row duration [s].
+        ds: Column width [m].
+        xcap0: Cap on v^2 [m^2/s^2] per column when cruising.
+        xcap1: Cap on v^2 [m^2/s^2] per column when accelerating at +-a_max.
         length: Path length L [m]; the motion ends at rest within ``a dt^2`` [m] before L.
-        t0, v0: Start time [s] and speed [m/s] (0 <= v0 <= v_max).
-        a_max, v_max: Limits [m/s^2], [m/s].
+        t0: Start time [s].
+        v0: Start speed [m/s] (0 <= v0 <= v_max).
+        a_max: Acceleration limit [m/s^2].
+        v_max: Speed limit [m/s].
         target_dt: Approximate lattice step [s] (see :func:`lattice_dt`).
         horizon_s: Latest arrival considered, counted from t0 [s].
         key_cells: The search keeps one node per (step, speed, ``key_cells`` map cells): the

@@ -128,7 +128,8 @@ def retime(traj: Trajectory, obstacles: Sequence[Any], spec: RobotSpec, *, margi
         spec: Robot limits and radius.
         margin: Extra clearance [m] kept from the obstacles.
         max_wait_s: Latest arrival considered, beyond the input's own arrival [s].
-        ds, h: Cell width [m] and row duration [s] of the s-t map.
+        ds: Cell width [m] of the s-t map.
+        h: Row duration [s] of the s-t map.
         target_dt: Approximate step [s] of the velocity lattice.
         free_tail_m: Path metres before the end never blocked (inside the goal tolerance).
 

@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 
 @njit(cache=True)
 def speed_bound(cv: CurveArrays, prof: ProfileArrays, nsub: int) -> float:
-    """max over profile intervals of (largest chord rate |dr|/ds over ``nsub`` equal parts)
+    """Max over profile intervals of (largest chord rate |dr|/ds over ``nsub`` equal parts)
     times the interval's larger end speed."""
     x, c, s_grid, u_grid, dus = cv.x, cv.c, cv.s_grid, cv.u_grid, cv.dus
     length = s_grid[-1]
