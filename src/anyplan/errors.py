@@ -1,6 +1,13 @@
-"""Exceptions raised by anyplan for bad input."""
+"""Exceptions raised by anyplan for bad input.
+
+Library errors name fields and parameters (``runs``, ``SimConfig.dt``), not command-line flags;
+the command line (:mod:`anyplan.cli.main`) maps them to its flags when it reports them.
+"""
 
 from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Self
 
 __all__ = ["AnyplanError", "ScenarioError", "UnknownNameError", "UsageError", "one_line", "shorten",
            "MAX_MESSAGE_CHARS"]
@@ -33,7 +40,35 @@ def shorten(value: object, limit: int = 40) -> str:
 
 
 class AnyplanError(Exception):
-    """Base class of anyplan's input errors; its message is one line, fit for a user."""
+    """Base class of anyplan's input errors; its message is one line, fit for a user.
+
+    An error made by :meth:`about` concerns one input, named by a field or parameter name
+    (``subject``, e.g. ``runs``), never by a command-line flag: the message is ``subject`` then
+    ``rest``. The command line tells it with its flag instead (:meth:`told_with`).
+    """
+
+    #: The field or parameter the message is about (None: not about one input).
+    subject: str | None = None
+    #: The message after the subject, e.g. ``" must be >= 1, got 0"`` or ``": not JSON"``.
+    rest: str = ""
+    #: Other inputs named in ``rest`` (as ``{name}``).
+    also: tuple[str, ...] = ()
+
+    @classmethod
+    def about(cls, subject: str, rest: str, *also: str) -> Self:
+        """An error about input ``subject``; ``rest`` starts with ``": "`` or ``" "``. Other
+        inputs it names are listed in ``also`` and written ``{name}`` in ``rest``."""
+        exc = cls(subject + (rest.format(**{a: a for a in also}) if also else rest))
+        exc.subject, exc.rest, exc.also = subject, rest, also
+        return exc
+
+    def told_with(self, names: Mapping[str, str]) -> str:
+        """The message, with its subject (and the inputs in ``also``) told by ``names[...]``
+        (e.g. a command-line flag) where ``names`` has them."""
+        if self.subject is None:
+            return str(self)
+        rest = self.rest.format(**{a: names.get(a, a) for a in self.also}) if self.also else self.rest
+        return names.get(self.subject, self.subject) + rest
 
 
 class UsageError(AnyplanError):

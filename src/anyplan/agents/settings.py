@@ -201,13 +201,13 @@ def parse_set_options(items: Sequence[str]) -> dict[str, Any]:
         key, sep, text = item.partition("=")
         key = key.strip()
         if not sep or not key:
-            raise SettingsError(f"--set: expected KEY=VALUE, got '{item}'")
+            raise SettingsError.about("setting", f": expected KEY=VALUE, got '{item}'")
         if key in out:
-            raise SettingsError(f"--set: '{key}' is given twice")
+            raise SettingsError.about("setting", f": '{key}' is given twice")
         try:
             out[key] = yaml.safe_load(text) if text.strip() else ""
         except yaml.YAMLError:
-            raise SettingsError(f"--set {key}: cannot read '{text}' as a YAML value") from None
+            raise SettingsError.about("setting", f" {key}: cannot read '{text}' as a YAML value") from None
     return out
 
 
@@ -219,7 +219,7 @@ def deterministic_settings(cls: type, planner: str) -> dict[str, Any]:
     """
     det = getattr(cls, "deterministic_settings", None)
     if det is None:
-        raise SettingsError(f"--deterministic: planner '{planner}' has no deterministic mode "
+        raise SettingsError.about("deterministic", f": planner '{planner}' has no deterministic mode "
                             "(its class sets no deterministic_settings)")
     return dict(det)
 
@@ -238,16 +238,16 @@ def build_agent_config(cls: type, planner: str, options: dict[str, Any],
     for key, value in options.items():
         if key not in known:
             err = UnknownNameError(f"setting of planner '{planner}'", key, list(known))
-            raise SettingsError(f"--set: {err}")
+            raise SettingsError.about("setting", f": {err}")
         s = known[key]
         try:
             config[key] = _coerce(s.hint, value)
         except TypeError:
-            raise SettingsError(f"--set {key}={value!r}: planner '{planner}' expects "
+            raise SettingsError.about("setting", f" {key}={value!r}: planner '{planner}' expects "
                                 f"{s.type_name} (default {s.default!r})") from None
     try:
         cls(**config)
     except (TypeError, ValueError) as exc:
         first = (str(exc).splitlines() or [""])[0]
-        raise SettingsError(f"--set: planner '{planner}' rejects its settings: {first}") from None
+        raise SettingsError.about("setting", f": planner '{planner}' rejects its settings: {first}") from None
     return config

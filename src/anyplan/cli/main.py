@@ -4,7 +4,8 @@ Each sub-command lives in its own module listed in :data:`COMMAND_MODULES`; a mo
 ``register(subparsers)`` which adds its parser and sets ``func`` (``args -> int``) as default.
 
 Bad input (an unknown scenario or planner, a malformed scenario file, a bad option value) ends
-with exit code 2 and one line on stderr, ``anyplan: error: ...``, never a traceback.
+with exit code 2 and one line on stderr, ``anyplan: error: ...``, never a traceback. Library
+errors name fields and parameters; :data:`FLAGS` tells them with the flags that set them.
 """
 
 from __future__ import annotations
@@ -19,7 +20,12 @@ from collections.abc import Sequence
 from anyplan import __version__
 from anyplan.errors import AnyplanError, UsageError, one_line
 
-__all__ = ["main", "COMMAND_MODULES", "UsageError"]
+__all__ = ["main", "COMMAND_MODULES", "UsageError", "FLAGS"]
+
+#: Library field and parameter names (:attr:`AnyplanError.subject`) -> the flags that set them.
+FLAGS = {"runs": "--runs", "jobs": "--jobs", "planners": "--planners", "config": "--config",
+         "scheduler": "--scheduler", "per_count": "--random-count", "suite": "--suite",
+         "setting": "--set", "deterministic": "--deterministic"}
 
 #: Modules that each register one or more sub-commands.
 COMMAND_MODULES = [
@@ -79,7 +85,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except AnyplanError as exc:
-        sys.stderr.write(one_line(f"anyplan: error: {exc}") + "\n")
+        sys.stderr.write(one_line(f"anyplan: error: {exc.told_with(FLAGS)}") + "\n")
         return 2
     except KeyboardInterrupt:
         sys.stderr.write("anyplan: interrupted\n")

@@ -79,23 +79,24 @@ def parse_planners(text: str, configs: Sequence[str] = ()) -> list[PlannerSpec]:
     """
     names = [s.strip() for s in text.split(",") if s.strip()]
     if not names:
-        raise BenchError("--planners: expected a comma-separated list of planner names")
+        raise BenchError.about("planners", ": expected a comma-separated list of planner names")
     if len(set(names)) != len(names):
-        raise BenchError(f"--planners: a planner is listed twice ({text})")
+        raise BenchError.about("planners", f": a planner is listed twice ({text})")
     cfg: dict[str, dict[str, Any]] = {}
     for item in configs:
         name, sep, blob = item.partition("=")
         name = name.strip()
         if not sep or not name:
-            raise BenchError(f"--config: expected NAME=JSON, got '{item}'")
+            raise BenchError.about("config", f": expected NAME=JSON, got '{item}'")
         if name not in names:
-            raise BenchError(f"--config: planner '{name}' is not in --planners ({', '.join(names)})")
+            raise BenchError.about("config", f": planner '{name}' is not in {{planners}} "
+                                   f"({', '.join(names)})", "planners")
         try:
             obj = json.loads(blob)
         except json.JSONDecodeError as exc:
-            raise BenchError(f"--config {name}: not JSON ({exc.msg} at column {exc.colno})") from None
+            raise BenchError.about("config", f" {name}: not JSON ({exc.msg} at column {exc.colno})") from None
         if not isinstance(obj, dict):
-            raise BenchError(f"--config {name}: expected a JSON object like {{\"key\": 1}}")
+            raise BenchError.about("config", f" {name}: expected a JSON object like {{\"key\": 1}}")
         cfg.setdefault(name, {}).update(obj)
     return [PlannerSpec(n, cfg.get(n, {})) for n in names]
 
@@ -111,7 +112,7 @@ def check_planner_config(spec: PlannerSpec) -> None:
     try:
         make_agent(spec.name, **spec.config)
     except (TypeError, ValueError) as exc:
-        raise BenchError(f"--config {spec.name}: {exc}") from None
+        raise BenchError.about("config", f" {spec.name}: {exc}") from None
 
 
 def derive_seed(master_seed: int, run_index: int) -> int:
@@ -187,7 +188,7 @@ def plan_tasks(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], r
     """All tasks, ordered run-major so that partial results cover every planner and scenario;
     ``sim`` (if given) replaces ``dt`` and ``time_limit``."""
     if runs < 1:
-        raise BenchError(f"--runs must be >= 1, got {runs}")
+        raise BenchError.about("runs", f" must be >= 1, got {runs}")
     sim = sim if sim is not None else _sim_config(dt, time_limit)
     entries = {p.name: _planner_entry(p.name) for p in planners}
     for p in planners:
@@ -257,12 +258,12 @@ def _dask(tasks: Sequence[RunTask], scheduler: Any) -> Iterator[tuple[RunTask, d
     try:
         from distributed import Client, as_completed
     except ImportError:
-        raise BenchError("--scheduler needs Dask: pip install 'anyplan[dask]'") from None
+        raise BenchError.about("scheduler", " needs Dask: pip install 'anyplan[dask]'") from None
     own = not hasattr(scheduler, "submit")
     try:
         client = Client(scheduler, timeout="20s") if own else scheduler
     except (OSError, TimeoutError) as exc:
-        raise BenchError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
+        raise BenchError.about("scheduler", f" {scheduler}: cannot connect ({exc})") from None
     try:
         futs = {}
         for t in tasks:
@@ -317,7 +318,7 @@ def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], ru
     """
     stream = stream if stream is not None else sys.stderr
     if jobs < 1:
-        raise BenchError(f"--jobs must be >= 1, got {jobs}")
+        raise BenchError.about("jobs", f" must be >= 1, got {jobs}")
     sim = sim if sim is not None else _sim_config(dt, time_limit)
     dt, time_limit = sim.dt, sim.time_limit
     all_tasks = plan_tasks(scenarios, planners, runs, master_seed, sim=sim)

@@ -38,7 +38,7 @@ def resolve_suite(suite: str, random_seed: int = 0, per_count: int = 1) -> list[
         scenarios = [load_scenario(n) for n in PAPER_SUITE]
     elif suite == "random":
         if per_count < 1:
-            raise SuiteError(f"--random-count must be >= 1, got {per_count}")
+            raise SuiteError.about("per_count", f" must be >= 1, got {per_count}")
         scenarios = random_suite(random_seed, per_count=per_count)
     elif suite == "gaps":
         from anyplan.experiments.gaps import gap_suite
@@ -52,7 +52,7 @@ def resolve_suite(suite: str, random_seed: int = 0, per_count: int = 1) -> list[
     else:
         items = [s.strip() for s in suite.split(",") if s.strip()]
         if not items:
-            raise SuiteError("empty --suite")
+            raise SuiteError.about("suite", ": empty (no scenario names or files)")
         scenarios = [load_scenario(s) for s in items]
     seen: dict[str, str] = {}
     for sc in scenarios:
