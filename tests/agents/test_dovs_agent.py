@@ -18,6 +18,7 @@ from anyplan.baselines.dovs import DOVSConfigError
 from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.simulation import SimConfig, simulate
 from anyplan.world import load_scenario
+from anyplan.world.robot import RobotLimits
 
 
 def _sampled_clearance(sc, res) -> float:
@@ -91,10 +92,10 @@ def test_agent_rejects_unknown_parameters() -> None:
 
 def test_robot_limits_come_from_the_scenario() -> None:
     sc = load_scenario("paper-1")
-    agent = DOVSAgent(v_max=1.0)
+    agent = DOVSAgent(limits=RobotLimits(v_max=1.0))
     agent.reset(sc.static_only(), np.random.default_rng(0))
     assert agent.config.v_max == sc.robot.v_max and agent.config.robot_radius == sc.robot.radius
-    free = DOVSAgent(v_max=0.3, use_robot_limits=False)
+    free = DOVSAgent(limits=RobotLimits(v_max=0.3), use_robot_limits=False)
     free.reset(sc.static_only(), np.random.default_rng(0))
     assert free.config.v_max == 0.3
 

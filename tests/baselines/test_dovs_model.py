@@ -21,6 +21,7 @@ from anyplan.baselines.dovs import (
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.shapes import Circle, rectangle
 from anyplan.prediction.base import ObstacleObservation
+from anyplan.world.robot import RobotLimits
 
 CFG = DOVSConfig()
 TS = np.linspace(0.0, CFG.time_horizon_s, 2401)
@@ -88,7 +89,8 @@ def test_no_collision_missed_against_brute_force(kind: str, merge: str) -> None:
 def test_no_collision_missed_for_curved_rays_near_obstacles() -> None:
     """Tight arcs that re-enter a band (the authors' first-crossing rule misses these)."""
     rng = np.random.default_rng(5)
-    cfg = DOVSConfig(v_max=0.7, omega_max=3.14, time_horizon_s=10.0, velocity_space="rectangle")
+    cfg = DOVSConfig(limits=RobotLimits(v_max=0.7, omega_max=3.14), time_horizon_s=10.0,
+                     velocity_space="rectangle")
     gv, gw = vs_grid(cfg, 24)
     ts = np.linspace(0.0, cfg.time_horizon_s, 4001)
     paths = _robot_paths(gv, gw, ts)

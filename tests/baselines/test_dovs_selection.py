@@ -21,6 +21,7 @@ from anyplan.baselines.dovs import (
     vs_v_max,
 )
 from anyplan.prediction.base import ObstacleObservation
+from anyplan.world.robot import RobotLimits
 
 CFG = DOVSConfig()
 
@@ -56,8 +57,11 @@ def test_table1_defaults() -> None:
     ("safety_factor", 0.9), ("static_range", 0.0), ("brake_along_ray", 1),
 ])
 def test_config_rejects_bad_values_naming_the_field(field: str, value: object) -> None:
+    # The robot's limits are one record; DOVS names them v_max, a_v (= a_max), ...
+    limit = {"v_max": "v_max", "a_v": "a_max"}.get(field)
+    kw = {"limits": RobotLimits(**{limit: value})} if limit else {field: value}
     with pytest.raises(DOVSConfigError, match=f"DOVSConfig.{field}"):
-        DOVSConfig(**{field: value})
+        DOVSConfig(**kw)
 
 
 def test_chosen_command_is_free_whenever_a_free_window_sample_exists() -> None:

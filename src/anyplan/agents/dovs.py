@@ -6,17 +6,17 @@ constant) and the static map given at reset, picks a command with the greedy sel
 it until the next period. ``stats.planning_times_s`` holds the wall-clock time of each period's
 computation; ``stats.extra`` counts how often each selection mode and goal target was used.
 
-By default the robot limits (v_max, omega_max, a_max, alpha_max, radius) are taken from the
-scenario's robot, so that the dynamic window never asks for more than the robot can do; for
-the built-in paper scenarios they equal the paper's Table 1 values, the defaults of
-:class:`~anyplan.baselines.dovs.config.DOVSConfig`.
+By default the config's ``limits`` are the scenario's robot's
+(:attr:`~anyplan.world.robot.RobotSpec.limits`), so that the dynamic window never asks for more
+than the robot can do; for the built-in paper scenarios they equal the paper's Table 1 values,
+the defaults of :class:`~anyplan.baselines.dovs.config.DOVSConfig`.
 """
 
 from __future__ import annotations
 
 import time
 from collections import Counter
-from dataclasses import asdict, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -36,8 +36,8 @@ class DOVSAgent(Agent):
 
     Args:
         config: A :class:`DOVSConfig`; keyword arguments override its fields.
-        use_robot_limits: Take v_max, omega_max, a_v, a_omega and robot_radius from the
-            scenario's robot at reset (default True).
+        use_robot_limits: Take the config's ``limits`` (radius, speeds, accelerations) from the
+            scenario's robot at reset (default True); False keeps ``config.limits``.
         **overrides: Any :class:`DOVSConfig` field.
 
     Raises:
@@ -68,8 +68,7 @@ class DOVSAgent(Agent):
         spec = scenario.robot
         cfg = self.base_config
         if self.use_robot_limits:
-            cfg = replace(cfg, v_max=spec.v_max, omega_max=spec.omega_max, a_v=spec.a_max,
-                          a_omega=spec.alpha_max, robot_radius=spec.radius)
+            cfg = replace(cfg, limits=spec.limits)
         self.config = cfg
         static = StaticMap([o.shape for o in scenario.static_obstacles], scenario.bounds, cfg)
         self.planner = DOVSPlanner(cfg, spec.goal, static)
@@ -81,7 +80,7 @@ class DOVSAgent(Agent):
         self.stats.planning_times_s.clear()
         self.stats.extra.clear()
         self.stats.extra.update({"control_period_s": cfg.control_period_s,
-                                 "dovs_config": asdict(cfg)})
+                                 "dovs_config": cfg.to_dict()})
 
     def decide(self, obs: Observation) -> Decision:
         """Run one DOVS period on ``obs`` (does not change the held command or the stats)."""

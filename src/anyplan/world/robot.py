@@ -7,7 +7,26 @@ from dataclasses import dataclass
 
 from anyplan.geometry.se2 import unicycle_arc, wrap_angle
 
-__all__ = ["RobotSpec", "RobotState", "Command", "clip_command", "step"]
+__all__ = ["RobotLimits", "RobotSpec", "RobotState", "Command", "clip_command", "step"]
+
+
+@dataclass(frozen=True)
+class RobotLimits:
+    """A disc robot's size and dynamic limits (the defaults: the paper's Table 1 robot).
+
+    Attributes:
+        radius: Radius [m] of a disc that contains the footprint.
+        v_max: Maximum linear speed [m/s].
+        omega_max: Maximum turn rate [rad/s].
+        a_max: Maximum linear acceleration [m/s^2].
+        alpha_max: Maximum angular acceleration [rad/s^2].
+    """
+
+    radius: float = 0.3
+    v_max: float = 0.4
+    omega_max: float = 0.4
+    a_max: float = 0.4
+    alpha_max: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -36,6 +55,11 @@ class RobotSpec:
     alpha_max: float = 1.0
     goal_tolerance: float = 0.2
     sensing_range: float | None = None
+
+    @property
+    def limits(self) -> RobotLimits:
+        """The robot's size and dynamic limits as one record (e.g. for a planner's settings)."""
+        return RobotLimits(self.radius, self.v_max, self.omega_max, self.a_max, self.alpha_max)
 
 
 @dataclass(frozen=True)

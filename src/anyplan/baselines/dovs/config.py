@@ -18,10 +18,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from typing import Any
 
 from anyplan.config import SettingError, setting, validate
+from anyplan.world.robot import RobotLimits
 
 __all__ = ["DOVSConfig", "DOVSConfigError"]
+
+#: The robot's limits under DOVS's names: (DOVS name, RobotLimits attribute).
+_LIMIT_NAMES = (("v_max", "v_max"), ("omega_max", "omega_max"), ("a_v", "a_max"),
+                ("a_omega", "alpha_max"), ("robot_radius", "radius"))
 
 
 class DOVSConfigError(SettingError):
@@ -36,13 +42,11 @@ class DOVSConfig:
         control_period_s: T [s], the DOVS sampling period: the command is recomputed every T and
             held in between. The dynamic window is the set reachable within T. Default 0.2 s
             (5 Hz, the authors' ROS node).
-        v_max: Maximum linear speed [m/s] (Table 1: 0.4).
-        omega_max: Maximum turn rate [rad/s] (Table 1: 0.4).
-        a_v: Linear acceleration limit [m/s^2] used by the dynamic window and the braking rule
-            (Table 1: a_max = 0.4).
-        a_omega: Angular acceleration limit [rad/s^2] (Table 1: alpha_max = 1.0).
-        robot_radius: Robot disc radius [m] (0.3: a Pioneer P3-DX footprint, as in the
-            built-in scenarios).
+        limits: The robot's radius and dynamic limits (:class:`~anyplan.world.robot.RobotLimits`;
+            the default is Table 1's robot: radius 0.3 m, v_max = omega_max = a_max = 0.4,
+            alpha_max = 1.0). The model reads them under DOVS's names, as the read-only views
+            ``v_max``, ``omega_max``, ``a_v`` (= a_max), ``a_omega`` (= alpha_max) and
+            ``robot_radius``; the ``dovs`` agent takes them from the scenario's robot.
         safety_factor: Moving obstacles are inflated to R = rho_obstacle + safety_factor *
             robot_radius; static obstacles are kept at safety_factor * robot_radius (1.1, the
             authors' code).
@@ -84,12 +88,8 @@ class DOVSConfig:
     """
 
     control_period_s: float = setting(0.2, lo=0.0, lo_open=True, unit="s", doc="sampling period T")
-    v_max: float = setting(0.4, lo=0.0, lo_open=True, unit="m/s", doc="maximum linear speed")
-    omega_max: float = setting(0.4, lo=0.0, lo_open=True, unit="rad/s", doc="maximum turn rate")
-    a_v: float = setting(0.4, lo=0.0, lo_open=True, unit="m/s^2", doc="linear acceleration limit")
-    a_omega: float = setting(1.0, lo=0.0, lo_open=True, unit="rad/s^2",
-                             doc="angular acceleration limit")
-    robot_radius: float = setting(0.3, lo=0.0, lo_open=True, unit="m", doc="robot disc radius")
+    limits: RobotLimits = setting(default_factory=RobotLimits,
+                                  doc="the robot's radius, speed and acceleration limits")
     safety_factor: float = setting(1.1, lo=1.0, doc="inflation of the robot radius")
     time_horizon_s: float = setting(8.0, lo=0.0, lo_open=True, hi=600.0, unit="s",
                                     doc="conflicts later than this are ignored")
@@ -113,9 +113,53 @@ class DOVSConfig:
                                        unit="rad", doc="a goal beyond this bearing is behind")
 
     def __post_init__(self) -> None:
+        if not isinstance(self.limits, RobotLimits):
+            raise DOVSConfigError("DOVSConfig", "limits", f"must be a RobotLimits, got {self.limits!r}")
+        for name, attr in _LIMIT_NAMES:
+            val = getattr(self.limits, attr)
+            if isinstance(val, bool) or not isinstance(val, int | float) or not math.isfinite(val) \
+                    or not val > 0.0:
+                raise DOVSConfigError("DOVSConfig", name, f"must be > 0 (limits.{attr}), got {val!r}")
         validate(self, DOVSConfigError)
         if self.dw_samples % 2 == 0:
             raise DOVSConfigError("DOVSConfig", "dw_samples", f"must be odd, got {self.dw_samples}")
+
+    # --- the robot's limits under DOVS's names (views of ``limits``, not copies) ------------
+    @property
+    def v_max(self) -> float:
+        """Maximum linear speed [m/s]: ``limits.v_max``."""
+        return self.limits.v_max
+
+    @property
+    def omega_max(self) -> float:
+        """Maximum turn rate [rad/s]: ``limits.omega_max``."""
+        return self.limits.omega_max
+
+    @property
+    def a_v(self) -> float:
+        """Linear acceleration limit [m/s^2] of the window and the braking rule: ``limits.a_max``."""
+        return self.limits.a_max
+
+    @property
+    def a_omega(self) -> float:
+        """Angular acceleration limit [rad/s^2]: ``limits.alpha_max``."""
+        return self.limits.alpha_max
+
+    @property
+    def robot_radius(self) -> float:
+        """Robot disc radius [m]: ``limits.radius``."""
+        return self.limits.radius
+
+    def to_dict(self) -> dict[str, Any]:
+        """The parameters as a flat dictionary (the limits under DOVS's names, as in
+        ``result.json``'s ``extra.dovs_config``)."""
+        out: dict[str, Any] = {}
+        for f in fields(self):
+            if f.name == "limits":
+                out.update((name, getattr(self.limits, attr)) for name, attr in _LIMIT_NAMES)
+            else:
+                out[f.name] = getattr(self, f.name)
+        return out
 
     # --- derived quantities ---------------------------------------------------------------
     @property
