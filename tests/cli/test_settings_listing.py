@@ -20,4 +20,4 @@ def test_st_bitstar_lists_its_own_loop_defaults_not_sequential_ones(capsys):
     seq = _section(out, "seq-bitstar")
     assert any(line.startswith("max_time_s = 0.5 ") for line in seq)
     dovs = _section(out, "dovs")
-    assert "v_max = 0.4  (float, > 0, m/s): maximum linear speed" in dovs
+    assert "control_period_s = 0.2  (float, > 0, s): sampling period T" in dovs
