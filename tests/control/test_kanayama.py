@@ -115,7 +115,7 @@ def test_closed_loop_accuracy_random_paths(seed):
     obs = ObstacleSet([Circle((6.0, 8.0), 0.5)], bounds=(0.0, 0.0, 12.0, 10.0))
     th0 = float(rng.uniform(-np.pi, np.pi))
     tr = plan_motion(path, SPEC, RobotState(*path[0], th0), obs, 0.0, shortcut=False)
-    t, states, e = run(tr, RobotState(*path[0], th0))
+    _, states, e = run(tr, RobotState(*path[0], th0))
     assert math.sqrt(np.mean(e**2)) < 0.05 and e.max() < 0.15
     # in fact the mean-rate feedforward makes it far smaller
     assert e.max() < 1e-3

@@ -10,7 +10,7 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-import anyplan_bench_test_agents as agents  # noqa: E402
+import anyplan_bench_test_agents as agents
 
 agents.register_all()
 

@@ -145,7 +145,7 @@ def test_cli_import_writes_the_index(tmp_path, capsys):
     assert set(load_index(tmp_path / "o")) == {"barn-007", "barn-008"}
 
 
-@pytest.mark.parametrize("argv, message", [
+@pytest.mark.parametrize(("argv", "message"), [
     (["--source", "missing.json"], "missing.json: no such file"),
     (["--worlds", "3-x"], "is not an index or a range"),
     (["--worlds", "9-5"], "empty range"),
@@ -167,7 +167,7 @@ def test_default_source_missing_is_a_clear_error(tmp_path, capsys, monkeypatch):
     assert "worlds.json: no such file (pass --source" in err and err.count("\n") == 1
 
 
-@pytest.mark.parametrize("change, message", [
+@pytest.mark.parametrize(("change", "message"), [
     ({"cylinders": [[-1.0, 6.0]]}, r"world 7\.cylinders\[0\]: expected \[x, y, radius\]"),
     ({"cylinders": [[-1.0, 6.0, -0.1]]}, r"world 7\.cylinders\[0\]\.radius: expected a positive"),
     ({"cylinders": [[-1.0, "6", 0.075]]}, r"world 7\.cylinders\[0\]: expected a finite number"),

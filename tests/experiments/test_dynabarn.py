@@ -89,7 +89,7 @@ def test_cli_import(tmp_path, capsys):
     assert "wrote 2 scenarios" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("argv, message", [
+@pytest.mark.parametrize(("argv", "message"), [
     (["--worlds-file", "missing.json"], "missing.json: no such file"),
     (["--worlds", "3-x"], "is not an index or a range"),
     (["--worlds", "90"], "outside 0-59"),

@@ -8,9 +8,9 @@ import pytest
 from anyplan.experiments.gaps import (
     ROOM,
     WALL_X,
-    gap_world,
     gap_scenario,
     gap_suite,
+    gap_world,
     issue_gap_scenario,
     waiting_is_safe,
 )

@@ -68,5 +68,5 @@ def test_suites(tmp_path, tiny_file):
     assert [s.name for s in resolve_suite(f"{tiny_file},paper-1")] == ["tiny", "paper-1"]
     empty = tmp_path / "empty"
     empty.mkdir()
-    with pytest.raises(SuiteError, match="no .yaml"):
+    with pytest.raises(SuiteError, match=r"no \.yaml"):
         resolve_suite(str(empty))

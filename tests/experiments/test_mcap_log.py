@@ -11,12 +11,12 @@ import pytest
 
 pytest.importorskip("mcap_ros2")
 
-from mcap.reader import make_reader  # noqa: E402
-from mcap_ros2.decoder import DecoderFactory  # noqa: E402
+from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
 
-from anyplan.cli.main import main  # noqa: E402
-from anyplan.experiments.mcap_log import TOPICS  # noqa: E402
-from anyplan.world import load_scenario  # noqa: E402
+from anyplan.cli.main import main
+from anyplan.experiments.mcap_log import TOPICS
+from anyplan.world import load_scenario
 
 
 def _read(path):
@@ -82,7 +82,8 @@ def test_run_as_mcap_reads_back_equal_to_the_run(tmp_path, capsys):
     assert len(squares) == len(res["virtual_obstacles"]) >= 1
     for m, v in zip(squares, res["virtual_obstacles"], strict=True):
         xs = [p.x for p in m.points]
-        assert max(xs) - min(xs) == pytest.approx(v["side"]) and np.mean(xs[:4]) == pytest.approx(v["center"][0])
+        assert max(xs) - min(xs) == pytest.approx(v["side"])
+        assert np.mean(xs[:4]) == pytest.approx(v["center"][0])
     static = msgs["/map/static"]
     assert len(static) == 1 and static[0][0] == 0
     assert {m.ns for m in static[0][1].markers} >= {"walls", "static", "goal"}

@@ -16,7 +16,7 @@ import anyplan.gym  # noqa: E402, F401 - registers the environment
 from anyplan.agents import make_agent  # noqa: E402
 from anyplan.agents.policy import ObservationEncoder, PolicyAgent  # noqa: E402
 from anyplan.experiments.runner import PlannerSpec, run_bench  # noqa: E402
-from anyplan.simulation import SimConfig, simulate  # noqa: E402
+from anyplan.simulation import simulate  # noqa: E402
 from anyplan.world import load_scenario, scenario_from_dict  # noqa: E402
 from tests.conftest import small_scenario_dict  # noqa: E402
 from tests.gym.policies import go_to_goal  # noqa: E402
@@ -35,7 +35,7 @@ def test_passes_the_gymnasium_checker(scenario):
 
 def test_observation_is_padded_and_nearest_first():
     env = gymnasium.make("anyplan/Nav-v0", scenario="paper-3", max_obstacles=5).unwrapped
-    obs, info = env.reset(seed=0)
+    obs, _ = env.reset(seed=0)
     sc = load_scenario("paper-3")
     r = sc.robot
     assert obs[:2] == pytest.approx([r.goal[0] - r.start[0], r.goal[1] - r.start[1]])
@@ -109,7 +109,8 @@ def test_a_policy_is_benchmarked_beside_seq_bitstar(tmp_path):
     import sqlite3
 
     con = sqlite3.connect(tmp_path / "b.db")
-    rows = con.execute("SELECT p.name, r.outcome FROM runs r JOIN plannerConfigs p ON r.plannerid = p.id").fetchall()
+    rows = con.execute("SELECT p.name, r.outcome FROM runs r "
+                       "JOIN plannerConfigs p ON r.plannerid = p.id").fetchall()
     con.close()
     assert sorted(n for n, _ in rows) == ["policy", "policy", "seq-bitstar", "seq-bitstar"]
     assert all(oc == "reached" for n, oc in rows if n == "seq-bitstar")

@@ -16,16 +16,16 @@ from matplotlib.figure import Figure
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "experiments"))
 
-import anyplan_bench_test_agents as agents  # noqa: E402
+import anyplan_bench_test_agents as agents
 
-import anyplan.viz.dovs as viz_dovs  # noqa: E402
-import anyplan.viz.planner as viz_planner  # noqa: E402
-import anyplan.viz.report as viz_report  # noqa: E402
-import anyplan.viz.run as viz_run  # noqa: E402
-from anyplan.agents import make_agent  # noqa: E402
-from anyplan.cli.main import main  # noqa: E402
-from anyplan.simulation import simulate  # noqa: E402
-from anyplan.viz.style import (  # noqa: E402
+import anyplan.viz.dovs as viz_dovs
+import anyplan.viz.planner as viz_planner
+import anyplan.viz.report as viz_report
+import anyplan.viz.run as viz_run
+from anyplan.agents import make_agent
+from anyplan.cli.main import main
+from anyplan.simulation import simulate
+from anyplan.viz.style import (
     MIN_FONT_PT,
     TEXT_WIDTH_IN,
     layout_problems,
@@ -33,7 +33,7 @@ from anyplan.viz.style import (  # noqa: E402
     qualitative_colors,
     save_figure,
 )
-from anyplan.world.scenario import scenario_from_dict  # noqa: E402
+from anyplan.world.scenario import scenario_from_dict
 
 agents.register_all()
 

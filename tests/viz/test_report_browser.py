@@ -16,9 +16,9 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "experiments"))
 
-import anyplan_bench_test_agents as agents  # noqa: E402
+import anyplan_bench_test_agents as agents
 
-from anyplan.cli.main import main  # noqa: E402
+from anyplan.cli.main import main
 
 agents.register_all()
 

@@ -62,5 +62,5 @@ def test_waypoint_motion_loops_and_hits_keyframes_exactly():
         np.testing.assert_allclose(m.position(t), [x, y] if t < 8.0 else [0.0, 0.0], atol=1e-12)
     np.testing.assert_allclose(m.position(8.0 + 3.5), m.position(3.5))
     assert m.max_speed == pytest.approx(math.hypot(2.0, 3.0) / 3.0)
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="keyframe times must start at 0 and increase strictly"):
         WaypointMotion(np.array([[0.0, 0, 0], [0.0, 1, 1]]))

@@ -26,7 +26,7 @@ def test_positions_exact_at_samples_and_linear_between():
     assert not m.exists(t[-1] + 1e-6)
     seg = np.hypot(*np.diff(xy, axis=0).T) / np.diff(t)
     assert m.max_speed == pytest.approx(seg.max())
-    x, y, th, v, w = m.state(0.5 * (t[3] + t[4]))
+    *_, v, w = m.state(0.5 * (t[3] + t[4]))
     assert v == pytest.approx(seg[3]) and w == 0.0
     assert m.state(t[-1] + 1.0)[3] == 0.0
 

@@ -34,7 +34,8 @@ import numpy as np
 from anyplan.experiments.generate import P3DX, GenerationError
 from anyplan.world.scenario import Scenario, scenario_from_dict
 
-__all__ = ["ROOM", "WALL_X", "gap_scenario", "gap_world", "gap_suite", "issue_gap_scenario", "waiting_is_safe"]
+__all__ = ["ROOM", "WALL_X", "gap_scenario", "gap_world", "gap_suite", "issue_gap_scenario",
+           "waiting_is_safe"]
 
 #: Room (width, height) [m].
 ROOM = (12.0, 8.0)
@@ -96,7 +97,8 @@ def _head_on_walker(rng: np.random.Generator, name: str, y_gap: float, t_meet: f
     y0 = y_gap + float(rng.uniform(-0.5, 0.5))
     p_gap = (WALL_X, y_gap)
     p_past = (WALL_X - 0.9, y_gap)
-    corner = (WALL_X - 1.2, WALKER_R + 0.1) if rng.random() < 0.5 else (WALL_X - 1.2, ROOM[1] - WALKER_R - 0.1)
+    corner = ((WALL_X - 1.2, WALKER_R + 0.1) if rng.random() < 0.5
+              else (WALL_X - 1.2, ROOM[1] - WALKER_R - 0.1))
     d1 = math.hypot(x0 - p_gap[0], y0 - p_gap[1])
     t_start = t_meet - d1 / v
     pts = [(x0, y0), (x0, y0), p_gap, p_past, corner]

@@ -161,7 +161,8 @@ def _static_markers(scenario: Scenario) -> list[dict[str, Any]]:
                            scale=(0.0, 0.0, 0.3), color=_color(0.0, 0.0, 0.0), text=o.name))
     g = scenario.robot
     out.append(_marker(0.0, "goal", 0, _CYLINDER, pose=_pose(g.goal[0], g.goal[1], 0.0, 0.01),
-                       scale=(2 * g.goal_tolerance, 2 * g.goal_tolerance, 0.02), color=_color(0.1, 0.7, 0.2, 0.6)))
+                       scale=(2 * g.goal_tolerance, 2 * g.goal_tolerance, 0.02),
+                       color=_color(0.1, 0.7, 0.2, 0.6)))
     return out
 
 
@@ -193,7 +194,7 @@ def write_mcap(path: str | Path, scenario: Scenario, result: RunResult | Mapping
         raise McapUnavailable("--mcap needs the 'mcap' extra: pip install 'anyplan[mcap]'") from None
     res = result.to_dict() if isinstance(result, RunResult) else dict(result)
     traj = np.asarray(res["trajectory"], dtype=float).reshape(-1, 6)
-    summary = McapSummary(Path(path), {k: 0 for k in TOPICS})
+    summary = McapSummary(Path(path), dict.fromkeys(TOPICS, 0))
     with open(path, "wb") as fh:
         w = Writer(fh)
         schemas = {name: w.register_msgdef(name, schema_text(name)) for name in set(TOPICS.values())}
@@ -206,7 +207,7 @@ def write_mcap(path: str | Path, scenario: Scenario, result: RunResult | Mapping
         put("/map/static", 0.0, {"markers": _static_markers(scenario)})
         # Everything stamped at one time goes out in time order: log times never decrease.
         events: list[tuple[float, int, str, dict[str, Any]]] = []
-        for k, (t, x, y, th, _v, _w) in enumerate(traj):
+        for t, x, y, th, _v, _w in traj:
             events.append((t, 0, "/robot/pose", {"header": _header(t), "pose": _pose(x, y, th)}))
             events.append((t, 1, "/tf", {"transforms": [{
                 "header": _header(t), "child_frame_id": ROBOT_FRAME,

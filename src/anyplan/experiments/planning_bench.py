@@ -150,7 +150,8 @@ def _experiment(db: ResultsDB, sc: Scenario, seed: int, budget_s: float, runs: i
          datetime.now(UTC).strftime("%Y-%m-%d %H:%M:%S"), str(seed),
          json.dumps(sc.static_only().to_dict()), h))
     db.conn.commit()
-    return int(cur.lastrowid)
+    assert cur.lastrowid is not None  # set by the INSERT
+    return cur.lastrowid
 
 
 def run_planning_bench(scenarios: Sequence[Scenario], db_path: str | Path, *, runs: int = 10,
@@ -167,7 +168,8 @@ def run_planning_bench(scenarios: Sequence[Scenario], db_path: str | Path, *, ru
         ompl: OMPL geometric planner class names; empty or None for ours only.
         master_seed: Seeds our runs (``derive_seed``) and OMPL's generator (once).
         resume: Skip runs already stored; without it, stored runs are refused.
-        progress: Show a progress bar on ``stream`` (default stderr).
+        progress: Show a progress bar.
+        stream: Where the progress bar goes (default stderr).
 
     Raises:
         BenchError: bad input, OMPL requested but not installed, or runs already stored.
@@ -250,7 +252,8 @@ def planning_table(db: ResultsDB, fractions: Sequence[float] = (0.1, 0.5, 1.0)) 
         [f"cost @{f:g}xbudget [m]" for f in fractions]
     out = []
     for (scn, planner, budget), ids in groups.items():
-        firsts, at = [], {f: [] for f in fractions}
+        firsts: list[float] = []
+        at: dict[float, list[float]] = {f: [] for f in fractions}
         solved = 0
         for rid in ids:
             prog = db.progress(rid)

@@ -8,7 +8,6 @@ and true positions over the 12 predicted frames, **FDE** the distance at the las
 averaged over the samples. Samples start every ``stride`` frames (1 = every frame).
 
 Methods:
-
 * ``cv``, the constant-velocity baseline: the last observed displacement, extrapolated;
 * ``imm``, our tracker (:class:`~anyplan.prediction.tracking.Tracker`) fed the 8 observed
   positions (plus Gaussian noise of ``noise_m``, seeded), predicted along its mean constant

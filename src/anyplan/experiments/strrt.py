@@ -83,13 +83,12 @@ def _worker(problem: dict[str, Any]) -> dict[str, Any]:  # pragma: no cover - ru
     import time
 
     import numpy as np
-
-    from anyplan.geometry.moving import first_contact
-    from anyplan.world.scenario import scenario_from_dict
-
     from ompl import base as ob  # after numpy (see the module docstring)
     from ompl import geometric as og
     from ompl import util as ou
+
+    from anyplan.geometry.moving import first_contact
+    from anyplan.world.scenario import scenario_from_dict
 
     sc = scenario_from_dict(problem["scenario"], "<strrt problem>")
     r = sc.robot

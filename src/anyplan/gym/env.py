@@ -67,6 +67,8 @@ class NavEnv(gymnasium.Env):
     """
 
     metadata = {"render_modes": []}  # noqa: RUF012 - gymnasium's convention
+    action_space: spaces.Box
+    observation_space: spaces.Box
 
     def __init__(self, scenario: ScenarioLike | Sequence[ScenarioLike] = "paper-3", max_obstacles: int = 8,
                  dt: float = 0.05, time_limit: float | None = None, progress_weight: float = 1.0,
@@ -126,8 +128,8 @@ class NavEnv(gymnasium.Env):
             self.scenario = self.scenarios[int(self.np_random.integers(len(self.scenarios)))]
         self.sim = Simulation(self.scenario, self.config, seed=self._seed)
         if self.sim.done:
-            raise ValueError(f"scenario {self.scenario.name}: nothing to simulate "
-                             f"({'goal proven unreachable' if self.sim.unreachable else 'start at the goal'})")
+            why = "goal proven unreachable" if self.sim.unreachable else "start at the goal"
+            raise ValueError(f"scenario {self.scenario.name}: nothing to simulate ({why})")
         self.encoder = ObservationEncoder(self.scenario.robot.goal, self.max_obstacles)
         self._dist = self._distance()
         return self._obs(), self._info()

@@ -26,6 +26,7 @@ from typing import Any
 import matplotlib
 import numpy as np
 from matplotlib import animation
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Rectangle
 
@@ -154,11 +155,11 @@ def animate_run(scenario: Scenario, result: Any, path: str | Path, *, speed: flo
     colors = qualitative_colors(len(scenario.moving_obstacles))
     for k, o in enumerate(scenario.moving_obstacles):
         c = colors[k]
-        patch = CirclePatch((0, 0), o.radius, fc=c, ec="black", alpha=0.85, zorder=7)
-        ax.add_patch(patch)
+        disc = CirclePatch((0, 0), o.radius, fc=c, ec="black", alpha=0.85, zorder=7)
+        ax.add_patch(disc)
         label = ax.text(0, 0, o.name, fontsize=8, ha="center", va="bottom", color=c, weight="bold",
                         zorder=9, path_effects=halo())
-        movers.append((o, patch, label))
+        movers.append((o, disc, label))
     clock = ax.text(0.01, 0.99, "", transform=ax.transAxes, ha="left", va="top", fontsize=10,
                     bbox={"fc": "white", "ec": "0.6", "alpha": 0.85}, zorder=10)
     if virtual:
@@ -171,7 +172,7 @@ def animate_run(scenario: Scenario, result: Any, path: str | Path, *, speed: flo
                  f"real time x {speed:g}", fontsize=10)
 
     dynamic: list[Any] = [v[1] for v in virtual] + [plan_line, trail] + \
-        [a for _, patch, label in movers for a in (patch, label)] + [robot, heading, clock]
+        [a for _, disc, label in movers for a in (disc, label)] + [robot, heading, clock]
     for a in dynamic:
         a.set_animated(True)
 
@@ -182,11 +183,11 @@ def animate_run(scenario: Scenario, result: Any, path: str | Path, *, speed: flo
         heading.set_data([x, x + r * math.cos(th)], [y, y + r * math.sin(th)])
         k = int(np.searchsorted(traj[:, 0], t, side="right"))
         trail.set_data(np.append(traj[:k, 1], x), np.append(traj[:k, 2], y))
-        for o, patch, label in movers:
+        for o, disc, label in movers:
             px, py = o.position(t)
-            patch.center = (px, py)
+            disc.center = (px, py)
             label.set_position((px, py + o.radius + 0.05))
-            patch.set_visible(o.motion.exists(t))
+            disc.set_visible(o.motion.exists(t))
             label.set_visible(o.motion.exists(t))
         if plans:
             j = int(np.searchsorted(plan_times, t, side="right")) - 1
@@ -203,6 +204,7 @@ def animate_run(scenario: Scenario, result: Any, path: str | Path, *, speed: flo
     fig.tight_layout()
     placer.layout()
     canvas = fig.canvas
+    assert isinstance(canvas, FigureCanvasAgg)  # new_figure's own canvas
     canvas.draw()
     background = canvas.copy_from_bbox(fig.bbox)
     frames = []

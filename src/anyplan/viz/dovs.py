@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from matplotlib.artist import Artist
 from matplotlib.colors import to_rgba
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle as CirclePatch
@@ -58,7 +59,7 @@ def draw_velocity_space(ax: Any, decision: Decision, *, resolution: int = 241, l
     img = np.ones(W.shape + (4,))
     img[..., 3] = 0.0
     any_src = np.zeros(len(v), dtype=bool)
-    handles = []
+    handles: list[Artist] = []
     hull_only = merged & ~np.any(by_src, axis=1) & inside
     if np.any(hull_only):
         img.reshape(-1, 4)[hull_only] = to_rgba(HULL_COLOR, 0.9)

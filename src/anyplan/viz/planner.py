@@ -50,7 +50,7 @@ def draw_planner(ax: Any, problem: Problem, result: PlanResult,
     ax.plot([], [], "s", color="0.35", label="obstacle")
     if data is not None:
         if len(data.edges):
-            ax.add_collection(LineCollection(data.edges, colors="tab:blue", linewidths=0.4,
+            ax.add_collection(LineCollection(data.edges, colors="tab:blue", linewidths=0.4,  # type: ignore[arg-type]
                                              alpha=0.6, zorder=3))
             ax.add_line(Line2D([], [], color="tab:blue", lw=0.8, label="tree"))
         if len(data.samples):

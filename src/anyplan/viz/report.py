@@ -96,7 +96,7 @@ def figure4(db: ResultsDB, path: str | Path, max_columns: int = 3, png_copy: Any
     exps: dict[str, int] = {}
     for r in sorted(runs, key=lambda r: (r["n_moving"] or 0, r["scenario"], r["experimentid"])):
         exps.setdefault(r["scenario"], r["experimentid"])
-    names = [n for n in ("paper-1", "paper-2", "paper-3") if n in exps] or list(exps)
+    names: list[str] = [n for n in ("paper-1", "paper-2", "paper-3") if n in exps] or list(exps)
     names = names[:max_columns]
     panels: dict[tuple[int, int], tuple[dict[str, Any], dict[str, Any], list[dict[str, Any]]]] = {}
     for i, planner in enumerate(planners):

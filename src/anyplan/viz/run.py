@@ -165,7 +165,7 @@ def draw_run(ax: Any, scenario: Scenario, result: Any, *, marked_times: Sequence
 
     # Moving obstacles: their trajectory over the run and their discs at the marked times.
     ts = np.linspace(0.0, t_end, max(2, int(t_end / 0.1) + 1))
-    time_requests = []
+    time_requests: list[tuple[Any, str, Any]] = []
     for j, o in enumerate(scenario.moving_obstacles):
         col = colors[j]
         lo, hi = o.motion.span  # a recorded track exists only within its span
@@ -193,11 +193,12 @@ def draw_run(ax: Any, scenario: Scenario, result: Any, *, marked_times: Sequence
                             arrowprops={"arrowstyle": "->", "color": col, "lw": 1.0}, zorder=4)
 
     # Executed path coloured by time, and the robot at the marked times.
-    robot_requests = []
+    robot_requests: list[tuple[Any, str, Any]] = []
     if len(traj) > 1:
         pts = traj[:, 1:3]
         segs = np.stack([pts[:-1], pts[1:]], axis=1)
-        lc = LineCollection(segs, cmap=cmap, norm=norm, lw=2.0, zorder=5)
+        # An (N, 2, 2) array of segments (the stubs ask for a sequence of them).
+        lc = LineCollection(segs, cmap=cmap, norm=norm, lw=2.0, zorder=5)  # type: ignore[arg-type]
         lc.set_array(traj[:-1, 0])
         ax.add_collection(lc)
         if colorbar:

@@ -15,14 +15,18 @@ import colorsys
 import contextlib
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import matplotlib
+import numpy as np
 from matplotlib import patheffects
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.text import Text
 from matplotlib.transforms import Bbox
+
+if TYPE_CHECKING:
+    from matplotlib.typing import RcKeyType
 
 __all__ = ["COLUMN_WIDTH_IN", "TEXT_WIDTH_IN", "MIN_FONT_PT", "FORMATS", "PAPER_RC", "paper_style",
            "qualitative_colors", "halo", "LabelPlacer", "save_figure", "figure_path",
@@ -37,7 +41,7 @@ MIN_FONT_PT = 8.0
 #: File formats the figures can be written in.
 FORMATS = ("png", "svg", "pdf")
 
-PAPER_RC: dict[str, Any] = {
+PAPER_RC: dict[RcKeyType, Any] = {
     "font.size": 8.0, "axes.titlesize": 8.0, "axes.labelsize": 8.0, "xtick.labelsize": 8.0,
     "ytick.labelsize": 8.0, "legend.fontsize": 8.0, "legend.title_fontsize": 8.0,
     "figure.titlesize": 9.0, "axes.linewidth": 0.6, "xtick.major.width": 0.6,
@@ -95,7 +99,7 @@ class LabelPlacer:
         self.requests: list[tuple[tuple[float, float], str, float, dict[str, Any], bool]] = []
         self.artists: list[Text] = []
 
-    def add(self, xy: Sequence[float], text: str, *, gap_pt: float = 3.0, center: bool = False,
+    def add(self, xy: Sequence[float] | np.ndarray, text: str, *, gap_pt: float = 3.0, center: bool = False,
             **kw: Any) -> None:
         """Ask for ``text`` near the data point ``xy``: centred on it if ``center`` (and it fits),
         else beside it, ``gap_pt`` points away (plus further out if needed)."""
@@ -203,8 +207,9 @@ def layout_problems(fig: Any, min_font_pt: float = MIN_FONT_PT) -> list[str]:
     for t, b in boxes:
         if not _inside(b, frame, tol=1.0):
             problems.append(f"outside the figure: {t.get_text()!r}")
-        if t.get_fontsize() < min_font_pt - 1e-9:
-            problems.append(f"font {t.get_fontsize():g} pt < {min_font_pt:g} pt: {t.get_text()!r}")
+        size = float(t.get_fontsize())  # Text reports points (the stubs also allow names)
+        if size < min_font_pt - 1e-9:
+            problems.append(f"font {size:g} pt < {min_font_pt:g} pt: {t.get_text()!r}")
     for i, (t1, b1) in enumerate(boxes):
         for t2, b2 in boxes[i + 1:]:
             if _overlap(b1, b2, tol=1.0):

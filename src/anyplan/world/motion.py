@@ -57,6 +57,10 @@ class Motion:
         """Position at time ``t`` [s], shape (2,) [m]."""
         return self.positions(np.array([float(t)]))[0]
 
+    def state(self, t: float) -> tuple[float, float, float, float, float]:
+        """Pose and twist at time ``t`` [s]: (x [m], y [m], heading [rad], v [m/s], omega [rad/s])."""
+        raise NotImplementedError
+
     def jumps(self, t0: float, t1: float) -> tuple[Jump, ...]:
         """The jumps (teleports, not motions) of the position at times in (t0, t1] [s] (each
         end moved 1 ns later, so that a jump at t1 is reported once, not again from t0 = t1),

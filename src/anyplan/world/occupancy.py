@@ -223,7 +223,8 @@ def read_image(path: str | Path) -> tuple[np.ndarray, np.ndarray | None]:
         from PIL import Image  # Pillow: matplotlib's own image dependency
     except ImportError:  # pragma: no cover - Pillow is a dependency
         raise ValueError("reading PNG maps needs Pillow (pip install pillow)") from None
-    with Image.open(p) as im:
+    with Image.open(p) as opened:
+        im: Image.Image = opened
         if im.width * im.height > MAX_CELLS:
             raise ValueError(f"image {im.width} x {im.height} has more than {MAX_CELLS} pixels")
         mode = im.mode

@@ -60,7 +60,7 @@ class _StrictLoader(yaml.SafeLoader):
         super().__init__(stream)
         self._depth = 0
 
-    def compose_node(self, parent: Node | None, index: Any) -> Node:  # type: ignore[override]
+    def compose_node(self, parent: Node | None, index: Any) -> Node | None:
         self._depth += 1
         try:
             if self._depth > MAX_DEPTH:
@@ -70,7 +70,7 @@ class _StrictLoader(yaml.SafeLoader):
         finally:
             self._depth -= 1
 
-    def construct_mapping(self, node: Node, deep: bool = False) -> dict[Any, Any]:  # type: ignore[override]
+    def construct_mapping(self, node: Node, deep: bool = False) -> dict[Any, Any]:
         if isinstance(node, MappingNode):
             seen: set[Any] = set()
             for key_node, _ in node.value:
@@ -141,13 +141,13 @@ _StrictLoader.add_implicit_resolver(
     list("-+0123456789"))
 
 
+_CComposer: type[yaml.CSafeLoader] | None = None
 if getattr(yaml, "__with_libyaml__", False):
-    class _CComposer(yaml.CSafeLoader):  # type: ignore[name-defined,misc]
+    class _CSafeComposer(yaml.CSafeLoader):
         """libyaml's scanner, parser and composer (fast) with our resolvers."""
 
-    _CComposer.yaml_implicit_resolvers = _StrictLoader.yaml_implicit_resolvers
-else:  # pragma: no cover - PyYAML without libyaml
-    _CComposer = None
+    _CSafeComposer.yaml_implicit_resolvers = _StrictLoader.yaml_implicit_resolvers
+    _CComposer = _CSafeComposer
 
 # A bracket, a quoted string (skipped whole) or a comment.
 _FLOW_TOKEN = re.compile(r"""[\[\]{}]|"(?:[^"\\]|\\.)*"|'(?:[^']|'')*'|#[^\n]*""")
