@@ -17,8 +17,8 @@ MAX_MESSAGE_CHARS = 400
 
 
 def one_line(text: object, limit: int = MAX_MESSAGE_CHARS) -> str:
-    """``text`` as one bounded line: control characters (newlines, tabs, ...) escaped as
-    ``\\n``-style sequences, and the middle cut out (``...``) beyond ``limit`` characters."""
+    r"""``text`` as one bounded line: control characters (newlines, tabs, ...) escaped as
+    ``\n``-style sequences, and the middle cut out (``...``) beyond ``limit`` characters."""
     s = str(text)
     if len(s) > 4 * limit:  # escape only what can be shown
         s = s[: 2 * limit] + s[-2 * limit:]

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Callable, Iterator
-from typing import Generic, TypeVar
+from typing import Any, Generic, TypeVar
 
 from anyplan.errors import AnyplanError, UnknownNameError
 
@@ -76,7 +76,7 @@ class Registry(Generic[T]):
         if isinstance(entry, str):
             mod, _, attr = entry.partition(":")
             try:
-                obj = importlib.import_module(mod)
+                obj: Any = importlib.import_module(mod)
                 for part in attr.split(".") if attr else ():
                     obj = getattr(obj, part)
             except Exception as exc:  # noqa: BLE001 - any failure of third-party code at import
@@ -86,7 +86,7 @@ class Registry(Generic[T]):
                                 f"{type(exc).__name__}: {first}") from None
             entry = obj
             self._entries[name] = entry
-        return entry  # type: ignore[return-value]
+        return entry
 
     def names(self) -> list[str]:
         """Registered names, in registration order."""

@@ -27,7 +27,7 @@ import inspect
 import types
 import typing
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import yaml
@@ -53,7 +53,7 @@ class Setting:
     name: str
     default: Any
     hint: Any
-    spec: Spec = Spec()
+    spec: Spec = field(default_factory=Spec)
 
     @property
     def type_name(self) -> str:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from typing import Any
 
 from anyplan.cli import checks
 from anyplan.errors import UsageError
@@ -30,11 +31,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=cmd_dovs_plot)
 
 
-def _parse_params(items: list[str]) -> dict[str, object]:
+def _parse_params(items: list[str]) -> dict[str, Any]:
     from anyplan.baselines.dovs.config import DOVSConfig
 
     names = DOVSConfig.field_names()
-    out: dict[str, object] = {}
+    out: dict[str, Any] = {}
     for item in items:
         key, sep, raw = item.partition("=")
         key = key.strip()

@@ -57,14 +57,14 @@ def cmd_plan(args: argparse.Namespace) -> int:
     planner.solve(timed(args.time))
     result = planner.result()
     if result.lower_bound is None and problem.start_valid() and problem.goal_valid():
-        lb = lower_bound(problem)
-        result.lower_bound = lb if math.isfinite(lb) else None
+        bound = lower_bound(problem)
+        result.lower_bound = bound if math.isfinite(bound) else None
     out = {k: v for k, v in result.to_dict().items() if k not in ("planner", "stats")}
     if args.json:
         doc = {**out, "planner": result.planner, "scenario": scenario.name, "seed": args.seed,
                "time_budget_s": args.time, "stats": result.stats}
         Path(args.json).write_text(json.dumps(doc, indent=1))
-    if args.plot:
+    if plot is not None:
         from anyplan.viz.planner import save_planner_figure
 
         data = planner.planner_data() if hasattr(planner, "planner_data") else None

@@ -383,7 +383,7 @@ class ResultsDB:
 
     def done_keys(self) -> set[tuple[int, int, int, int]]:
         """``(experimentid, plannerid, run_index, seed)`` of every stored run."""
-        return {tuple(r) for r in self.conn.execute(  # type: ignore[misc]
+        return {(int(r[0]), int(r[1]), int(r[2]), int(r[3])) for r in self.conn.execute(
             "SELECT experimentid, plannerid, run_index, seed FROM runs WHERE run_index IS NOT NULL")}
 
     def add_run(self, experimentid: int, plannerid: int, row: Mapping[str, Any],

@@ -337,8 +337,8 @@ def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], ru
         done = db.done_keys()
         tasks = []
         for t in all_tasks:
-            t2 = replace(t, **{"experimentid": exp_ids[t.scenario_hash],
-                            "plannerid": plan_ids[(t.planner, settings_string(t.planner_config))]})
+            t2 = replace(t, experimentid=exp_ids[t.scenario_hash],
+                         plannerid=plan_ids[(t.planner, settings_string(t.planner_config))])
             if (t2.experimentid, t2.plannerid, t2.run_index, t2.seed) in done:
                 summary.skipped += 1
             else:

@@ -99,7 +99,7 @@ class RunResult:
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-serialisable dictionary (the ``result.json`` form; statuses as plain strings)."""
-        return _jsonable(asdict(self))  # type: ignore[no-any-return]
+        return dict(_jsonable(asdict(self)))
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> RunResult:

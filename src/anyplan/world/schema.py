@@ -57,6 +57,8 @@ class MovingObstacle:
 # Validation helpers
 # --------------------------------------------------------------------------------------------
 class Ctx:
+    """Checks of the fields of one scenario dictionary; failures name ``source`` and the field."""
+
     def __init__(self, source: str) -> None:
         self.source = source
 
@@ -128,10 +130,12 @@ class Ctx:
 
 
 def join_field(a: str, b: str) -> str:
+    """The dotted path of field ``b`` inside ``a`` (``b`` alone when ``a`` is the top)."""
     return f"{a}.{b}" if a else b
 
 
 def typename(obj: Any) -> str:
+    """The type of a user's value in words (``nothing`` for None)."""
     return "nothing" if obj is None else type(obj).__name__
 
 
@@ -222,6 +226,7 @@ def _lookup(c: Ctx, reg: Registry[Any], kind: Any, fld: str) -> Any:
 
 
 def parse_static(c: Ctx, obj: Any, fld: str, index: int) -> StaticObstacle:
+    """Static obstacle number ``index`` (field ``fld``); its ``type`` selects the parser."""
     m = c.mapping(obj, fld)
     if "type" not in m:
         raise c.fail(join_field(fld, "type"), "missing required key (rectangle, circle or polygon)")
@@ -239,6 +244,7 @@ def parse_static(c: Ctx, obj: Any, fld: str, index: int) -> StaticObstacle:
 
 
 def parse_moving(c: Ctx, obj: Any, fld: str, index: int) -> MovingObstacle:
+    """Moving obstacle number ``index`` (field ``fld``); its ``type`` selects the motion parser."""
     m = c.mapping(obj, fld)
     kind = m.get("type", "unicycle")
     name = c.string(m.get("name", f"D{index + 1}"), join_field(fld, "name"))
@@ -278,6 +284,7 @@ MOTION_TYPES.register("track", _parse_track)
 
 
 def parse_sensing(c: Ctx, obj: Any) -> SensingSpec:
+    """The ``sensing:`` block."""
     m = c.mapping(obj, "sensing")
     c.keys(m, "sensing", ("mode",), ("noise_m", "rate_hz"))
     mode = c.string(m["mode"], "sensing.mode")

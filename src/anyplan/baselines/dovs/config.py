@@ -17,7 +17,7 @@ Every field is declared with :func:`anyplan.config.setting` (range, choices, uni
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 from anyplan.config import SettingError, setting, validate
@@ -88,8 +88,7 @@ class DOVSConfig:
     """
 
     control_period_s: float = setting(0.2, lo=0.0, lo_open=True, unit="s", doc="sampling period T")
-    limits: RobotLimits = setting(default_factory=RobotLimits,
-                                  doc="the robot's radius, speed and acceleration limits")
+    limits: RobotLimits = field(default_factory=RobotLimits)  # checked in __post_init__
     safety_factor: float = setting(1.1, lo=1.0, doc="inflation of the robot radius")
     time_horizon_s: float = setting(8.0, lo=0.0, lo_open=True, hi=600.0, unit="s",
                                     doc="conflicts later than this are ignored")
