@@ -1,46 +1,16 @@
-"""Trajectory tracking with the control law of Kanayama, Kimura, Miyazaki & Noguchi,
-"A stable tracking control method for an autonomous mobile robot" (ICRA 1990), as in §4 of the
-paper.
+"""Trajectory tracking with Kanayama's control law, as in §4 of the paper.
 
-With the reference pose (x_r, y_r, theta_r) and the robot pose (x, y, theta), the error in the
-robot frame is::
-
-    e_x     =  cos(theta) (x_r - x) + sin(theta) (y_r - y)
-    e_y     = -sin(theta) (x_r - x) + cos(theta) (y_r - y)
-    e_theta =  wrap(theta_r - theta)
-
-and the command is::
+Kanayama, Kimura, Miyazaki & Noguchi, "A stable tracking control method for an autonomous
+mobile robot", ICRA 1990. With the error (e_x, e_y, e_theta) of the robot's pose against the
+reference in the robot frame, the command is
 
     v     = v_r cos(e_theta) + K_x e_x
     omega = omega_r + v_r (K_y e_y + K_theta sin(e_theta)) + K_turn sin(e_theta)
 
-saturated to |v| <= v_max, |omega| <= omega_max and to the acceleration limits over one control
-period. ``K_turn`` is our addition (0 gives Kanayama's law exactly): with v_r = 0 (turning in
-place) Kanayama's law has no heading feedback at all. It keeps Kanayama's Lyapunov function
-V = (e_x^2 + e_y^2) / 2 + (1 - cos e_theta) / K_y decreasing: it adds -K_turn sin^2(e_theta) / K_y
-to dV/dt.
-
-Feedforward. The simulator holds each command for one period dt. Using the reference's *mean*
-speed and turn rate over the coming period, v_r = (s(t+dt) - s(t)) / dt and
-omega_r = (theta_r(t+dt) - theta_r(t)) / dt, makes the robot land on the reference at the end of
-the period when it starts on it, so the feedback only has to correct disturbances and saturation,
-not discretisation lag.
-
-Gains (defaults). Linearising about zero error with constant v_r gives e_x' = -K_x e_x and
-e_y'' + v_r K_theta e_y' + v_r^2 K_y e_y = 0: a lateral oscillator of natural frequency
-w_n = v_r sqrt(K_y) and damping K_theta / (2 sqrt(K_y)). We choose critical damping,
-K_y = K_theta^2 / 4, with K_theta = 8 1/m and K_y = 16 1/m^2, so that at v_r = 0.4 m/s the
-lateral error decays at w_n = 1.6 rad/s (time constant ~0.6 s, about one robot length travelled).
-K_x = 2 1/s gives the same ~0.5 s time constant along the path. These are smaller than
-Kanayama's (K_x = 10, K_y = 64, K_theta = 16 in SI units): our robot's omega_max = 0.4 rad/s and
-alpha_max = 1 rad/s^2 are so low that stiffer gains only saturate and make the corrections
-bang-bang; and with dt = 0.05 s, K_x dt and w_n dt stay far below the discrete stability limit 2.
-K_turn = 2 1/s: heading errors while turning in place decay in ~0.5 s.
-
-Limitation: a robot that lags behind a reference running at v_max cannot catch up (its speed is
-capped at v_max too); the along-track error then persists until the reference slows down. The
-references of :func:`~anyplan.trajectory.plan_motion` start at the robot's own state, so in
-simulation the error stays at the micrometre level.
+saturated to the robot's speed and acceleration limits; v_r, omega_r are the reference's mean
+rates over the coming control period (feedforward), ``K_turn`` our heading feedback for turning
+in place. The gains, the feedforward and the limitation are derived in ``docs/motion.md``,
+"Tracking (Kanayama et al., ICRA 1990)".
 """
 
 from __future__ import annotations

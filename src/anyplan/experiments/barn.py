@@ -1,40 +1,13 @@
 """BARN's 300 static worlds as anyplan scenarios.
 
 BARN (D. Perille, A. Truong, X. Xiao, P. Stone, "Benchmarking Metric Ground Navigation", SSRR
-2020; the BARN Challenge) has 300 Gazebo worlds of static cylinders. ``shared/benchmarks/barn/
-worlds.json`` holds them as data (MIT, "Copyright (c) 2022 Zifan Xu", from the BARN Challenge
-repository): per world the cylinders ``[x, y, radius]`` and the challenge's reference path
-length. This module turns each world into a scenario dictionary of our schema, one static
-``circle`` per cylinder. The data does not ship with anyplan; the converter reads the file.
+2020; the BARN Challenge) has 300 Gazebo worlds of static cylinders. The converter reads the
+challenge's ``worlds.json`` (data, not shipped with anyplan) and writes one scenario per world:
+one static ``circle`` per cylinder, BARN's x shifted by :data:`SHIFT`, the challenge's start,
+goal and time limit, a Clearpath Jackal as a 0.34 m disc (:data:`JACKAL`), and the visibility
+graph's verdict on the world's feasibility for that disc (:func:`feasibility`).
 
-Conventions (BARN's Gazebo coordinates in brackets):
-
-* **Frame.** Our arena is ``[0, W] x [0, H]``; BARN's x is shifted by :data:`SHIFT` = +4.5 m,
-  y is unchanged, nothing is rotated or scaled.
-* **Arena.** The cylinders fill BARN's field ``[-4.5, 0] x [0, 9.6]``: its outermost columns
-  are the side walls (their outer faces are at x = -4.5 and x = 0) and its first row a wall
-  behind the start. The goal lies beyond the field's open far end, so the arena is
-  ``[-4.5, 0] x [0, 14]`` = 4.5 m x 14 m: the arena's side boundaries coincide with the side
-  walls' outer faces and continue them past the field (the robot has no reason to leave the
-  2.25 m strips either side of the goal), and the top boundary is 1 m past the goal.
-* **Task.** The challenge's (``run.py``): start (-2.25, 3.0) heading 1.57 rad (+y), goal
-  (-2.25, 13.0), i.e. (2.25, 3.0, 1.57) and (2.25, 13.0) here; success within 1 m of the goal
-  (``goal_tolerance`` 1.0), time limit 100 s.
-* **Robot: Clearpath Jackal** (:data:`JACKAL`). A disc of radius 0.34 m, which contains the
-  0.508 m x 0.430 m footprint (half-diagonal 0.3328 m). The limits are those of the Jackal's
-  own velocity controller, Clearpath's ROS package ``jackal_control/config/control.yaml``
-  (github.com/jackal/jackal): v_max 2.0 m/s (also Clearpath's published top speed and the
-  speed of the challenge's optimal time, path length / 2 m/s), linear acceleration 20 m/s^2,
-  omega_max 4.0 rad/s, angular acceleration 25 rad/s^2. Edit the YAML files (or pass
-  ``profile``) to change them.
-* **Obstacles.** Every cylinder is a static ``circle`` named ``cK`` (K = its index in the
-  file); its centre is BARN's (x + 4.5, y), one float addition, and its radius is the file's.
-* **Feasibility.** The disc is larger than the footprint, so some worlds may have no path for
-  it. :func:`feasibility` asks the visibility graph (:mod:`anyplan.planning.visgraph`):
-  ``feasible`` (its exact-checked path exists), ``infeasible`` (not even the relaxed, inscribed
-  obstacles leave a path: proven) or ``uncertain`` (a gap within the arc tolerance of 2 r).
-  :func:`convert` records it, with the reference length, in ``barn-index.json`` beside the
-  scenario files; benchmark tables report the feasible worlds apart from the others.
+Frame, arena, task, robot limits and feasibility: ``docs/experiments.md``, "BARN conventions".
 """
 
 from __future__ import annotations
@@ -56,7 +29,7 @@ __all__ = ["JACKAL", "SHIFT", "ARENA", "START", "GOAL", "TIME_LIMIT", "N_WORLDS"
            "BARNError", "Feasibility", "default_source", "load_worlds", "parse_worlds",
            "world_to_scenario", "feasibility", "convert", "load_index", "scenario_name"]
 
-#: Clearpath Jackal profile (see the module docstring), SI units.
+#: Clearpath Jackal profile (docs/experiments.md, "BARN conventions"), SI units.
 JACKAL: dict[str, float] = {"radius": 0.34, "v_max": 2.0, "omega_max": 4.0, "a_max": 20.0,
                             "alpha_max": 25.0, "goal_tolerance": 1.0}
 #: Added to BARN (x, y) [m].

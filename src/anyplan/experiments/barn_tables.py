@@ -1,21 +1,13 @@
 """The BARN table: our runs on BARN worlds beside the challenge's DWA baseline.
 
-For each planner configuration, one row for the worlds the visibility graph finds feasible for
-the robot's disc and one for the others (infeasible or uncertain, see
-:func:`anyplan.experiments.barn.feasibility`), with:
+One row per planner configuration for the worlds the visibility graph finds feasible for the
+robot's disc and one for the others, with outcome counts, time to the goal, time over the
+challenge's optimal time (reference path length / 2 m/s) and the challenge's score
+``success * optimal / clip(time, 2 optimal, 8 optimal)``. The DWA baseline
+(:data:`DWA_BASELINE`) is quoted from the BARN Challenge's README (Gazebo, real footprint), so
+it is context, not a like-for-like comparison.
 
-* worlds, runs, reached (goal within 1 m, no collision), collisions, robot-caused collisions
-  (when the results database has them), timeouts, errors;
-* time [s]: simulated time to the goal, mean ± sample std over the runs that reached it;
-* time / optimal: per reached run, time to the goal over the challenge's optimal time (its
-  reference path length / 2 m/s), mean ± std; the target is a mean time at most 1.5 times the
-  mean optimal time (``mean time / mean optimal`` is printed too);
-* score: the challenge's, per run ``success * optimal / clip(time, 2 optimal, 8 optimal)``
-  (0 for a failed run), mean over all runs.
-
-The challenge's DWA baseline (:data:`DWA_BASELINE`) is quoted from the BARN Challenge
-repository's README; it ran in Gazebo with the real footprint and sensing, 50 worlds x 10 runs,
-so it is context, not a like-for-like comparison.
+Columns: ``docs/experiments.md``, "The BARN table".
 """
 
 from __future__ import annotations
@@ -79,7 +71,7 @@ def _robot_caused(r: Mapping[str, Any]) -> bool | None:
 
 def summarize_barn(runs: Sequence[Mapping[str, Any]],
                    index: Mapping[str, Mapping[str, Any]]) -> list[BarnRow]:
-    """Rows (see the module docstring) of the ``runs`` (rows of :meth:`ResultsDB.runs`) on the
+    """Rows (docs/experiments.md, "The BARN table") of the ``runs`` (rows of :meth:`ResultsDB.runs`) on the
     scenarios of ``index`` (:func:`~anyplan.experiments.barn.load_index`); other runs ignored."""
     groups: dict[tuple[str, str, str], list[Mapping[str, Any]]] = {}
     for r in runs:

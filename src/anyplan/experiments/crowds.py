@@ -1,31 +1,14 @@
 """Recorded pedestrian crowds (ETH/UCY ``obsmat`` files) as anyplan scenarios.
 
-An ``obsmat`` file has one row per person and annotated frame, ``frame person x z y vx vz vy``
-(positions in metres in the ground plane; ``z`` unused; a row every 10 video frames, 0.4 s at
-25 frames/s). Each person becomes a moving obstacle of type ``track`` (a disc of 0.25 m whose
-samples are the annotated positions: exact at every sample, linear in between, present only
-between their first and last sample). People are replayed: they do not react to the robot.
+ETH (Pellegrini et al., ICCV 2009) and UCY (Lerner et al., Eurographics 2007) record people as
+rows ``frame person x z y vx vz vy`` every 0.4 s. Each person becomes a moving obstacle of type
+``track`` (a 0.25 m disc, exact at each sample, linear in between, present only within its
+samples); people are replayed, not reactive. A *window* ``[t0, t0 + length]`` of the recording
+is one scenario, with a robot crossing the scene along its longer side where nobody walks;
+``copies`` overlays shifted copies for denser crowds.
 
-Conventions:
-
-* **Time.** ``t = (frame - first frame of the file) / 25`` s. A *window* ``[t0, t0 + length]``
-  keeps every person's samples inside it, with times shifted by ``-t0``; people with fewer than
-  two samples in it are dropped. Windows start every ``step`` seconds.
-* **Frame.** The arena is the bounding box of every position of the file, grown by ``margin``
-  (1.5 m) on each side; positions are shifted by ``(margin - xmin, margin - ymin)`` (no rotation,
-  no scaling). The shift is stated in each scenario's description.
-* **The robot** crosses the scene along its longer side, ``edge`` (0.8 m) from the arena's
-  boundary at both ends, in the margin strip where nobody walks. Its lateral position is the
-  first of the centre line, then +-1 m, +-2 m, ... for which the start is clear (no person
-  within ``r + 0.25 + 0.5`` m of it during the window's first 2 s) and the goal not occupied
-  (no person within ``r + 0.25`` m of it for more than 2 s in total); a window with no such line
-  is skipped. Service-robot profile :data:`SERVICE_ROBOT` (options change it), sensing range
-  8 m, ``sensing: {mode: tracked}``.
-* **Denser crowds.** ``copies = K`` overlays K copies of the recording, copy k shifted by
-  ``k * copy_shift`` seconds, cyclically (the people of copy k at window time t are those of
-  the recording at ``(t0 + t + k * copy_shift) mod T``, T the recording's length plus one
-  annotation interval), named ``P<id>c<k>`` (a track cut by the wrap becomes two, the second
-  ``P<id>c<k>b``).
+Time, frame, the robot's crossing line and the copies: ``docs/perception.md``, "Recorded
+crowds: conventions".
 """
 
 from __future__ import annotations

@@ -3,34 +3,12 @@
 DynaBARN (A. Nair, F. Jiang, K. Hou, Z. Xu, S. Li, X. Xiao, P. Stone, "DynaBARN: Benchmarking
 Metric Ground Navigation in Dynamic Environments", SSRR 2022) has 60 Gazebo worlds (0-19 easy,
 20-39 medium, 40-59 hard): three static walls and 5-24 discs (r = 0.5 m) that loop along
-time-stamped piecewise-linear tracks. ``shared/benchmarks/dynabarn/worlds.json`` holds them as
-data (MIT, "Copyright (c) 2022 Zifan Xu", from the BARN Challenge repository); this module turns
-each world into a scenario dictionary of our schema, moving obstacles of type ``waypoints``.
+time-stamped piecewise-linear tracks. The converter reads the challenge's ``worlds.json`` (data,
+not shipped) and writes one scenario per world: moving obstacles of type ``waypoints``
+(D1..Dn), coordinates shifted by :data:`SHIFT`, the open +x side closed 1.5 m behind the start,
+the challenge's task and a Clearpath Jackal (:data:`JACKAL`).
 
-Conventions (DynaBARN coordinates in brackets):
-
-* **Frame.** Our arena is ``[0, W] x [0, H]``; DynaBARN's x and y are shifted by
-  :data:`SHIFT` = (+10.5, +10.5) m, nothing is rotated or scaled. Keyframe times are unchanged.
-* **Arena and the open +x side.** Every keyframe lies in [-10, 10]^2 and the discs have r = 0.5,
-  so obstacles stay within [-10.5, 10.5]^2. The Gazebo world has walls on three sides only
-  (back x = -10, top y = 10, bottom y = -10) and is open at +x, where the robot starts. We close
-  it with the arena boundary at x = 12.5, 1.5 m behind the start (the robot starts facing -x
-  and has no reason to go there), which gives an arena of 23 m x 21 m = [-10.5, 12.5] x
-  [-10.5, 10.5]. The three walls are kept as static rectangles; the 0.25 m strips between their
-  outer faces and the arena boundary are unreachable.
-* **Task.** The challenge's: start (11, 0) heading pi, goal (-9, 0), i.e. (21.5, 10.5, pi) and
-  (1.5, 10.5) here; time limit 100 s; goal tolerance 1.0 m (the challenge's ``run.py`` stops
-  within 1 m of the goal).
-* **Robot: Clearpath Jackal** (:data:`JACKAL`). Footprint 0.508 m x 0.430 m, so a 0.34 m disc
-  (the half-diagonal is 0.333 m). v_max = 2.0 m/s (Clearpath's top speed and the speed behind
-  the challenge's optimal time, path length / 2 m/s). The turn rate and accelerations are our
-  choice, conservative for a 17 kg skid-steer robot: omega_max = 2.0 rad/s, a_max = 2.0 m/s^2,
-  alpha_max = 4.0 rad/s^2. Edit the YAML files (or pass ``profile``) to change them.
-* **Moving obstacles.** ``{type: waypoints, keyframes: [[t, x, y], ...], radius: 0.5}``, named
-  D1..Dn in the world's order (the file's header comment maps them to DynaBARN's plugin names); the
-  position at time t is the linear interpolation at ``t mod period`` with period = the last
-  keyframe time, exactly DynaBARN's looping Gazebo ``PoseAnimation``. Positions are exact at the
-  keyframes (the shift is one float addition per coordinate).
+Frame, arena, task, robot limits and motions: ``docs/experiments.md``, "DynaBARN conventions".
 """
 
 from __future__ import annotations
@@ -50,7 +28,7 @@ from anyplan.world.scenario import scenario_from_dict
 __all__ = ["JACKAL", "SHIFT", "ARENA", "DynaBARNError", "default_worlds_path", "load_worlds",
            "parse_worlds", "world_to_scenario", "convert", "tier"]
 
-#: Clearpath Jackal profile (see the module docstring), SI units.
+#: Clearpath Jackal profile (docs/experiments.md, "DynaBARN conventions"), SI units.
 JACKAL: dict[str, float] = {"radius": 0.34, "v_max": 2.0, "omega_max": 2.0, "a_max": 2.0,
                             "alpha_max": 4.0, "goal_tolerance": 1.0}
 #: Added to DynaBARN (x, y) [m].

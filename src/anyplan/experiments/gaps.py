@@ -1,27 +1,14 @@
 """Gap worlds: a wall across a room with one gap, and walkers timed to meet the robot there.
 
-Every scenario is a 12 m x 8 m room with a wall (0.2 m thick) across it at x = 6 m, one gap of
-1.0-1.6 m, the paper's robot (Pioneer P3-DX profile) on the left and its goal on the right.
-Walkers (discs of 0.3 m) follow time-stamped tracks (``waypoints`` motions, known to the
-planners like the paper's obstacles):
+A 12 m x 8 m room, a wall at x = 6 m with one gap of 1.0-1.6 m, the paper's robot, and walkers
+(0.3 m discs on ``waypoints`` tracks) that either cross just behind the gap (``cross``) or come
+through it head-on (``head-on``), timed to meet a robot that drives straight at v_max. Waiting
+is always a way out, and each scenario is checked for it (:func:`waiting_is_safe`).
+:func:`issue_gap_scenario` is the case of issue 10. ``gap_suite(seed, n)`` names its scenarios
+``gap-s{seed}-{k}`` and draws scenario k from ``SeedSequence([seed, k])``.
 
-* ``cross``: a walker crosses the line of the gap just behind it (0.3-0.8 m past the wall's far
-  face), at 0.3-0.6 m/s, and is in front of the gap when a robot driving straight at v_max
-  would be; then it walks on to the room's wall and stays there;
-* ``head-on``: a walker comes from the right through the gap, towards the robot, timed to be in
-  the gap when the robot would be; past the gap it turns off to a corner of the room and stays.
-
-A timing-blind planner meets the walker in or just behind the gap; a planner that waits (or
-slows down) lets it pass. **Waiting is always a way out**, and each scenario is checked for it
-(:func:`waiting_is_safe`): no walker ever comes within ``r + r_w + 0.15`` m of the robot's start
-position, and after some time every walker stays at least ``r + r_w + 0.3`` m from the route
-(start, gap centre, goal), early enough to drive the route before the time limit.
-
-:func:`issue_gap_scenario` is the case of issue 10: a 1.2 m gap on the room's centre line and
-one walker at 0.3 m/s crossing just behind it.
-
-Everything is drawn from one ``numpy.random.Generator``; ``gap_suite(seed, n)`` names its
-scenarios ``gap-s{seed}-{k}`` and draws scenario k from ``SeedSequence([seed, k])``.
+How walkers are timed and what "waiting is safe" checks: ``docs/spacetime.md``, "Gap worlds:
+how they are drawn".
 """
 
 from __future__ import annotations
@@ -112,7 +99,8 @@ def _head_on_walker(rng: np.random.Generator, name: str, y_gap: float, t_meet: f
 
 
 def waiting_is_safe(scenario: Scenario, y_gap: float, step: float = 0.05) -> bool:
-    """True if waiting at the start, then driving the route, is a way out (module docstring).
+    """True if waiting at the start, then driving the route, is a way out (see
+    ``docs/spacetime.md``, "Gap worlds: how they are drawn").
 
     Checked on a time grid of ``step`` seconds, with the clearances enlarged by the distance a
     walker can cover in half a step.
@@ -158,7 +146,7 @@ def gap_world(name: str, desc: str, start: np.ndarray, goal: np.ndarray, y_gap: 
 
 def gap_scenario(rng: np.random.Generator | int, name: str = "gap", kind: str | None = None,
                  max_attempts: int = 100) -> Scenario:
-    """A random gap world (module docstring); ``kind`` is ``cross``, ``head-on`` or ``both``
+    """A random gap world (docs/spacetime.md, "Gap worlds"); ``kind`` is ``cross``, ``head-on`` or ``both``
     (one walker of each), random if None."""
     rng = np.random.default_rng(rng)
     for _ in range(max_attempts):

@@ -1,22 +1,13 @@
 """Random scenarios with moving obstacles that cross the robot's route.
 
-A generated scenario uses the paper's arena (15 m x 11 m) and robot (a Pioneer P3-DX inside a
-0.3 m disc, 0.4 m/s), a few random static shapes, and ``n_moving`` moving discs. Each moving
-obstacle is aimed at a point of the straight start-goal segment and reaches it when a robot
-driving that segment at ``v_max`` would (after a turn-in-place and acceleration allowance), so a
-robot that ignores it collides; that is what makes the scenario a test of avoidance rather than a
-static problem with decorations. The crossing angle is 45-135 degrees from the route; a third of
-the obstacles turn (constant omega), the rest go straight.
+A generated scenario has the paper's arena (15 m x 11 m) and robot, a few random static shapes
+and ``n_moving`` moving discs, each aimed at a point of the straight start-goal segment and
+reaching it when a robot driving the segment at ``v_max`` would: a robot that ignores them
+collides. Every scenario returned is checked valid (free start and goal, goal reachable among the
+static obstacles, obstacles starting inside the arena). The same seed gives the same scenario.
 
-Validity, checked for every scenario returned:
-
-* the start and goal discs are free of static obstacles (the schema's own check) and at least
-  0.5 m from every moving obstacle at t = 0;
-* the goal is reachable among the static obstacles: start and goal lie in the same connected
-  component of free space on a 5 cm grid with the obstacles inflated by the robot radius;
-* every moving obstacle starts inside the arena, and its crossing point is free of static shapes.
-
-Everything is drawn from one ``numpy.random.Generator``: the same seed gives the same scenario.
+Crossing angles, turning obstacles and the validity checks: ``docs/scenarios.md``, "Generated
+scenarios".
 """
 
 from __future__ import annotations

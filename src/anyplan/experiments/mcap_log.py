@@ -1,28 +1,12 @@
-"""A run as an MCAP file with ROS 2 messages, for Foxglove, RViz (through ``ros2 bag play``) and
-rosbag tools: ``anyplan run --mcap FILE``.
+"""A run as an MCAP file with ROS 2 messages (``anyplan run --mcap FILE``).
 
-Needs the optional extra ``anyplan[mcap]`` (``mcap``, ``mcap-ros2-support``). Every message is
-stamped with the **simulation time** (``header.stamp`` and the MCAP log time, in ns from the
-start of the run, t = 0 s). Frame: ``map`` (the scenario's x, y in m; z up); the robot's frame is
-``base_link``.
+For Foxglove, RViz (through ``ros2 bag play``) and rosbag tools; needs the extra
+``anyplan[mcap]``. Every message is stamped with the simulation time (ns from the start of the
+run); frames ``map`` (the scenario's x, y [m]) and ``base_link`` (the robot). Topics:
+``/robot/pose``, ``/tf``, ``/plan``, ``/map/static``, ``/obstacles``, ``/predictions`` and
+``/virtual_obstacles``.
 
-Topics:
-
-* ``/robot/pose`` (``geometry_msgs/msg/PoseStamped``): the robot's pose at every simulation step
-  (one message per row of ``result.trajectory``); ``/tf`` (``tf2_msgs/msg/TFMessage``): the same
-  as the transform ``map`` -> ``base_link``.
-* ``/plan`` (``nav_msgs/msg/Path``): each planned path, stamped with its creation time, the
-  heading of each pose along the path.
-* ``/map/static`` (``visualization_msgs/msg/MarkerArray``, once at t = 0): the arena's walls, the
-  static obstacles and the goal.
-* ``/obstacles`` (``MarkerArray``, every step): the moving obstacles (discs; a recorded track
-  only within its time span) and the robot's disc.
-* ``/predictions`` (``MarkerArray``, at each plan's creation time): the constant-twist prediction
-  (:class:`~anyplan.prediction.ConstantTwistPredictor`) of each obstacle visible then, over the
-  next ``prediction_horizon_s`` seconds, as a line; made from the exact observation at that
-  time (under a noisy perception mode the agent's own predictions differ by its sensing).
-* ``/virtual_obstacles`` (``MarkerArray``, at each creation time): the virtual static squares of
-  Sequential BIT* created by the replanning of that time (earlier ones are deleted).
+Message types and when each topic is written: ``docs/integrations.md``, "MCAP topics".
 """
 
 from __future__ import annotations

@@ -1,25 +1,13 @@
 """Anytime planning benchmark: best cost against planning time, ours beside OMPL's.
 
-For each scenario, among its **static** obstacles only (robot disc of the scenario's radius,
-start to goal), our BIT* (:func:`anyplan.planning.plan`, planner name ``anyplan_BITstar``) and
-OMPL's planners (optional ``ompl`` wheel, names ``geometric_<Planner>`` as in OMPL's benchmark
-logs) plan for ``budget_s`` seconds of wall time. Each run is stored in the results database
-(:mod:`anyplan.experiments.db`) as OMPL does: a ``runs`` row (``solved``, ``time`` = planning
-time [s], ``best_cost`` = final path length [m], ``status``) and its cost-over-time in
-``progress`` (``source = 'planner'``): our BIT*'s every improvement, OMPL's best cost sampled
-after cumulative ``solve`` calls at 12 log-spaced budgets (OMPL's planners resume). The report's
-``cost_time.png`` then draws them together.
+Among a scenario's static obstacles only, our BIT* (:func:`anyplan.planning.plan`, named
+``anyplan_BITstar``) and OMPL's planners (Sucan, Moll & Kavraki, "The Open Motion Planning
+Library", IEEE RAM 2012; optional ``ompl`` wheel, named ``geometric_<Planner>``) plan for
+``budget_s`` seconds each. Runs are stored as OMPL's benchmark logs are (:mod:`anyplan.experiments.db`:
+``runs`` and cost-over-time in ``progress``), one at a time in this process, OMPL with the same
+exact geometry as ours. These experiments have ``suite = 'planning'``.
 
-Fairness: OMPL gets the same exact geometry as ours, a state validity checker on
-:meth:`ObstacleSet.point_free` and an exact segment ``MotionValidator`` on
-:meth:`ObstacleSet.segment_free` (``shared/research/peers.md`` §3.1), both calling compiled
-kernels from Python. Runs are executed one at a time in this process (parallel runs would
-distort wall-clock costs on a small machine). OMPL's random generator can be seeded only once
-per process (with the master seed), so OMPL runs are not individually reproducible; ours are
-(seed = ``derive_seed(master, run)``).
-
-These experiments have ``suite = 'planning'`` and their runs no ``outcome``, so the paper
-tables and the execution figures ignore them.
+Fairness, seeding and what is stored: ``docs/experiments.md``, "Planning benchmark: protocol".
 """
 
 from __future__ import annotations
@@ -158,7 +146,8 @@ def run_planning_bench(scenarios: Sequence[Scenario], db_path: str | Path, *, ru
                        budget_s: float = 1.0, ompl: Sequence[str] | None = OMPL_DEFAULT,
                        master_seed: int = 0, resume: bool = False, progress: bool = True,
                        stream: TextIO | None = None) -> PlanningBenchSummary:
-    """Run the anytime planning benchmark (see the module docstring) into ``db_path``.
+    """Run the anytime planning benchmark into ``db_path`` (``docs/experiments.md``, "Planning
+    benchmark: protocol").
 
     Args:
         scenarios: Scenarios; only their static obstacles, robot radius, start and goal are used.

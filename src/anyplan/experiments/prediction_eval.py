@@ -1,19 +1,13 @@
 """Prediction accuracy on recorded pedestrians, the way the field reports it on ETH/UCY.
 
-Protocol (e.g. Alahi et al., Social LSTM, CVPR 2016; Schoeller et al., "What the constant
-velocity model can teach us about pedestrian motion prediction", RA-L 2020): every run of 20
-consecutive annotated frames of one person (2.5 Hz) is a sample; the first 8 (3.2 s) are
-observed, the next 12 (4.8 s) are predicted. **ADE** is the mean distance [m] between predicted
-and true positions over the 12 predicted frames, **FDE** the distance at the last one, both
-averaged over the samples. Samples start every ``stride`` frames (1 = every frame).
+The protocol of Alahi et al. (Social LSTM, CVPR 2016) and Schoeller et al. ("What the constant
+velocity model can teach us about pedestrian motion prediction", RA-L 2020): 8 observed frames
+(3.2 s), 12 predicted (4.8 s); **ADE** is the mean distance [m] between predicted and true
+positions over the predicted frames, **FDE** the distance at the last one. Methods: ``cv`` (the
+constant-velocity baseline) and ``imm`` (our tracker with its uncertainty disc, whose
+**coverage** is also reported).
 
-Methods:
-* ``cv``, the constant-velocity baseline: the last observed displacement, extrapolated;
-* ``imm``, our tracker (:class:`~anyplan.prediction.tracking.Tracker`) fed the 8 observed
-  positions (plus Gaussian noise of ``noise_m``, seeded), predicted along its mean constant
-  twist, with the uncertainty disc of :class:`~anyplan.prediction.uncertain.UncertaintyModel`:
-  **coverage** is the fraction of predicted frames whose true position lies within the disc's
-  extra radius of the predicted centre (per horizon and overall).
+Methods and coverage in detail: ``docs/perception.md``, "Prediction accuracy: protocol".
 """
 
 from __future__ import annotations

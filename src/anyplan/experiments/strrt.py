@@ -1,24 +1,13 @@
 """OMPL's STRRT* (Grothe et al., ICRA 2022) as an offline peer of ``st-bitstar``.
 
-STRRT* plans in (x, y, t) for a holonomic point robot with |v| <= v_max and no acceleration
-limit, minimising the arrival time (``ob.MinimizeArrivalTime``). We give it the scenario's
-static obstacles and the *true* motions of the moving obstacles (the paper's assumption: motion
-known), with exact validity checking:
+STRRT* plans in (x, y, t) for a holonomic point robot with |v| <= v_max, minimising the arrival
+time, given the static obstacles and the true motions of the moving ones, with exact validity
+checks (states and motions, the latter by :func:`anyplan.geometry.first_contact`). Only the
+``ompl`` 1.7 wheels expose it (``pip install 'anyplan[strrt]'``); each problem is solved in a
+fresh subprocess (``python -m anyplan.experiments.strrt``, JSON in and out) because of the
+wheel's import-order and exit traps.
 
-* a state (x, y, t) is valid when the robot's disc is free of every static shape and wall and
-  of every moving disc at time t;
-* a motion between two states is valid when time increases, the speed is at most v_max, the
-  segment is free of the static obstacles (exact segment clearance) and the robot moving on it
-  at constant velocity never touches a moving disc (the certified continuous contact search of
-  :func:`anyplan.geometry.first_contact`).
-
-Only the ``ompl`` 1.7 wheels expose STRRT*, ``SpaceTimeStateSpace`` and ``MinimizeArrivalTime``
-(``pip install 'anyplan[strrt]'``; the 2.0 wheels of the ``bench`` extra do not). The wheel has
-two traps: ``ompl`` must be imported after numpy, and the interpreter may crash at exit; so each
-problem is solved in a fresh subprocess (``python -m anyplan.experiments.strrt``, problem as JSON
-on stdin, answer as one JSON line on stdout) that leaves with ``os._exit``. ``site`` adds a
-directory to that subprocess's ``PYTHONPATH`` (e.g. a ``pip install --target`` of the 1.7 wheel
-next to a 2.0 install).
+Validity checks and the subprocess protocol: ``docs/spacetime.md``, "STRRT*: how it is run".
 """
 
 from __future__ import annotations
@@ -83,7 +72,7 @@ def _worker(problem: dict[str, Any]) -> dict[str, Any]:  # pragma: no cover - ru
     import time
 
     import numpy as np
-    from ompl import base as ob  # after numpy (see the module docstring)
+    from ompl import base as ob  # after numpy (docs/spacetime.md, "STRRT*: how it is run")
     from ompl import geometric as og
     from ompl import util as ou
 

@@ -1,20 +1,12 @@
 """Tables like the paper's Tables 2 and 3, computed from the results database.
 
-One table per planner configuration, one row per number of moving obstacles. Columns, as in
-the paper, plus the outcome counts the paper reports only as "crashed":
+One table per planner configuration, one row per number of moving obstacles, with the paper's
+columns (path length, path generation time, time to goal; mean ± sample std) plus the outcome
+counts (successes, collisions, robot-caused collisions, timeouts, errors) and the time over the
+run's lower bound. The paper's own numbers (Roy, Harchowdhury & Vachhani, Tables 2-3) are in
+:data:`PAPER_TABLES`.
 
-* path length [m]: executed path length, mean ± sample std over the runs that reached the goal;
-* path generation time [s]: per run, the mean wall time of its planning calls; mean ± std over
-  runs that planned at least once (this is our reading of the paper's "path generation time");
-* time to goal [s]: simulated time to reach the goal, mean ± std over successful runs;
-* successes (reached the goal without collision), collisions (collided with an obstacle; the
-  paper's "crashed"), robot-caused collisions (at first contact the robot's velocity had a
-  component > 0.05 m/s towards the obstacle), timeouts (neither within the time limit), errors
-  (the planner raised; OMPL's "Crash");
-* time / lower bound: time to goal over the run's ``time_lower_bound_s`` (the static shortest
-  path at the robot's limits), mean ± std over successful runs.
-
-The paper's own numbers (Roy, Harchowdhury & Vachhani, Tables 2-3) are in :data:`PAPER_TABLES`.
+What each column averages over: ``docs/experiments.md``, "The paper's tables: columns".
 """
 
 from __future__ import annotations

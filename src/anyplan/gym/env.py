@@ -1,32 +1,14 @@
 """``anyplan/Nav-v0``: drive the robot to its goal among static and moving obstacles.
 
-The environment steps :class:`anyplan.simulation.simulator.Simulation`, the simulator every
-planner runs in: the same unicycle integration, limits, collision test over each step and
-metrics; nothing is re-implemented here.
+The environment (Gymnasium's ``Env`` API) steps :class:`anyplan.simulation.simulator.Simulation`,
+the simulator every planner runs in. Observation: a float32 vector of ``8 + 7 * max_obstacles``
+values from :class:`anyplan.agents.policy.ObservationEncoder`; action: ``(v [m/s], omega
+[rad/s])`` within the robot's limits; reward: progress to the goal minus a time penalty, plus a
+goal reward or minus a collision penalty; terminated at the goal or a collision, truncated at
+the time limit.
 
-* **Scenario**: ``scenario`` is a built-in name (``"paper-3"``), a YAML file, a
-  :class:`~anyplan.world.Scenario`, a list of those (a suite: each reset picks one with the
-  environment's random generator), or ``"random"`` (a new random cluttered world with 1-6 moving
-  obstacles at each reset, :func:`anyplan.experiments.generate.random_scenario`).
-* **Observation**: a float32 vector (each value within +-``OBS_BOUND``) of length
-  ``8 + 7 * max_obstacles`` built by
-  :class:`anyplan.agents.policy.ObservationEncoder` from what a planner observes (the robot's
-  state relative to the goal, then the visible moving obstacles nearest first, padded with zero
-  slots; see :mod:`anyplan.agents.policy`).
-* **Action**: ``(v, omega)`` in m/s and rad/s, within ``[-v_max, v_max] x [-omega_max,
-  omega_max]`` of the robot (the largest over a suite). The simulator then limits the change of
-  speed per step by the robot's accelerations, as for every planner.
-* **Reward** per step: the decrease of the distance to the goal [m] (``progress_weight`` x it),
-  minus ``time_penalty`` (default 0.01); plus ``goal_reward`` (10) on reaching the goal, minus
-  ``collision_penalty`` (10) on a collision.
-* **Termination**: ``terminated`` at the goal (within the robot's ``goal_tolerance``) or at a
-  collision (with a static obstacle, a wall or a moving obstacle); ``truncated`` at the time
-  limit (the scenario's ``time_limit`` or ``time_limit``) when neither happened.
-* **Seeding**: ``reset(seed=...)`` seeds the choice of scenario (and the random worlds), and
-  the sensor's noise when the scenario's perception mode has noise, as ``simulate(...,
-  seed=...)`` does; with the default exact perception the simulation has no randomness.
-* ``info``: ``t`` [s], ``status`` (running, reached, collision, timeout), ``scenario`` (name),
-  ``min_clearance_m``, ``collision_with``, and ``result`` (the :class:`RunResult` at the end).
+Scenarios, seeding, reward terms and ``info``: ``docs/integrations.md``, "Gymnasium: the
+environment".
 """
 
 from __future__ import annotations

@@ -1,23 +1,13 @@
 """Tracking moving obstacles from noisy position detections: an IMM of two Kalman filters.
 
-Each obstacle (by name: the association is given) has a state ``[x, y, vx, vy, omega]``
-(m, m/s, rad/s) estimated by an interacting multiple model (IMM; Blom & Bar-Shalom 1988) of
+Each obstacle (by name: the association is given) has a state ``[x, y, vx, vy, omega]`` (m, m/s,
+rad/s) estimated by an interacting multiple model (Blom & Bar-Shalom, IEEE TAC 1988) of a
+constant-velocity (CV) and a coordinated-turn (CT, extended Kalman) filter that switch at
+``switch_rate`` [1/s]; measurements are positions with noise ``sigma_m`` [m] per axis. Tracks
+start at their first detection, coast while occluded and are dropped after ``drop_after_s``.
+Everything is vectorised over tracks.
 
-* **CV**, constant velocity: ``p' = p + v T``, ``v' = v``, with white-noise acceleration of
-  spectral density ``q_cv`` [m^2/s^3]; its turn rate is reset to 0 (``omega' = 0``);
-* **CT**, coordinated turn at the unknown rate omega (an extended Kalman filter: the velocity
-  turns by ``omega T``, ``p' = p + [[s, -(1-c)], [1-c, s]] v / omega``), white-noise acceleration
-  ``q_ct`` and a random walk of omega (``q_omega`` [rad^2/s^3]).
-
-Both models share the state, so mixing is the plain IMM moment matching. The models switch with
-rate ``switch_rate`` [1/s]. Measurements are positions with noise ``sigma_m`` [m] per axis.
-
-* **Appearing**: a new name starts a track at its detection, at rest with a velocity standard
-  deviation ``init_speed_sigma`` [m/s].
-* **Occluded**: no detection in a frame, the track *coasts*: it is predicted (covariance growing).
-* **Leaving**: a track not detected for ``drop_after_s`` seconds is dropped.
-
-Everything is vectorised over tracks (arrays of shape (N, 2, 5) and (N, 2, 5, 5)).
+The models and their noise terms: ``docs/perception.md``, "The IMM tracker".
 """
 
 from __future__ import annotations

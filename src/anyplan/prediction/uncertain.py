@@ -1,21 +1,16 @@
 """Predictions with uncertainty: tracked obstacles as discs that grow with the horizon.
 
 A track (:class:`~anyplan.prediction.tracking.TrackEstimate`) is predicted along its mean
-motion (a constant twist: speed, heading and turn rate of the IMM estimate, i.e. a line or a
-circle); the turn rate is kept only when the IMM is confident the obstacle turns
-(P(CT) >= ``turn_confidence``, 0.7), since extrapolating a noisy turn rate over seconds is worse
-than a straight line (measured on ETH/UCY, ``benchmarks/unknown.py``). Its disc grows with the horizon tau [s] by
+constant twist (its turn rate kept only when P(CT) >= ``turn_confidence``), and its disc grows
+with the horizon tau [s] by
 
     extra(tau) = min(k * sqrt(lambda_max(Sigma(tau))) + a_m tau^2 / 2, cap),
 
-with ``Sigma(tau) = F(tau) P F(tau)^T`` the position block of the estimate's covariance P
-propagated through the coordinated-turn Jacobian F(tau) (linearised at the mean),
-``a_m`` a manoeuvre allowance [m/s^2] (what the filter cannot foresee: a pedestrian who
-changes her mind) and ``cap`` [m] the largest extra radius; ``extra`` is evaluated at the knots
-:attr:`UncertaintyModel.taus` (up to the horizon cap, constant beyond) and interpolated linearly
-between them (:class:`~anyplan.prediction.base.RadiusGrowth`). For a 2-D Gaussian error the
-k-sigma disc of the largest axis holds the truth with probability at least ``1 - exp(-k^2/2)``
-(86 % for k = 2), before the allowance.
+Sigma(tau) the position covariance propagated through the coordinated-turn Jacobian, ``a_m`` a
+manoeuvre allowance [m/s^2] and ``cap`` [m] the largest extra radius.
+
+Why the turn rate is gated, the knots and the coverage bound: ``docs/perception.md``,
+"Uncertain prediction: the growing disc".
 """
 
 from __future__ import annotations

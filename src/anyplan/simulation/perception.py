@@ -1,23 +1,14 @@
 """The robot's sensor: what each perception mode lets an agent see of the moving obstacles.
 
-Modes (:class:`~anyplan.world.sensing.SensingSpec`, ``docs/scenarios.md`` "Sensing"):
+Modes (:class:`~anyplan.world.sensing.SensingSpec`): ``oracle`` (exact pose, twist and motion
+model within ``robot.sensing_range``, the paper's assumption), ``twist`` (the same without the
+motion model) and ``tracked`` (noisy position detections of the visible obstacles at the sensor
+rate). An obstacle is visible when its centre is in range and in line of sight past the static
+obstacles; it exists only within its motion's span. Noise comes from a Generator seeded with
+``(seed, NOISE_STREAM)``: the same seed, the same noise.
 
-* ``oracle``: every obstacle within ``robot.sensing_range`` (all of them without a range), with
-  its exact pose and twist and its motion model (the paper's assumption);
-* ``twist``: the same, without the motion model (the agent must extrapolate);
-* ``tracked``: :class:`~anyplan.prediction.detection.Detection` records only, one per visible
-  obstacle and sensor frame: the centre plus Gaussian noise of ``noise_m`` [m] per axis, the
-  name and the radius, nothing else. Frames come at ``rate_hz``: the first simulation step at or
-  after each multiple of ``1 / rate_hz`` seconds. An obstacle is visible when its centre is within
-  ``robot.sensing_range`` of the robot's centre and the segment between the two centres misses
-  every static obstacle (the exact segment clearance of the geometry kernels is > 0). The
-  *centre* rule is our choice: a disc that is partly hidden is seen only if its centre is; the
-  arena walls do not occlude (everything is inside them).
-
-In every mode an obstacle exists only within its motion's span (recorded tracks): outside it,
-it is not observed. The noise comes from a Generator seeded with ``(seed, NOISE_STREAM)``, ``seed``
-being the run's seed, so that the same seed gives the same noise and the agent's own random
-stream is untouched.
+Frames, visibility and seeding: ``docs/perception.md``, "Perception modes: what the sensor
+sees".
 """
 
 from __future__ import annotations

@@ -1,20 +1,12 @@
 """Animations of one run: robot, moving obstacles, current plan and virtual obstacles over time.
 
-Each frame shows, at simulated time t:
+Each frame shows, at simulated time t, the static scene (:func:`anyplan.viz.run.draw_scenario`),
+the robot and its trail, the moving obstacles, the latest plan made at or before t, the virtual
+obstacles that exist at t, the time and, at the end, the outcome. Frames are ``speed / fps``
+simulated seconds apart (real time x ``speed``); the static scene is drawn once and the moving
+artists blitted on the Agg canvas. GIFs are written with Pillow, MP4 through ffmpeg.
 
-* the static scene (arena, static obstacles, start and goal), drawn by
-  :func:`anyplan.viz.run.draw_scenario`;
-* the robot's disc and heading at t, with its trail so far;
-* every moving obstacle's disc at its true position at t (from the scenario's motions);
-* the current plan: the latest entry of ``result["plans"]`` (``{t, path}``) made at or before t;
-* the virtual static obstacles (``result["virtual_obstacles"]``, ``{center, side, created_at_s}``)
-  that exist at t, as blue squares appearing when they are created;
-* the time, the speed-up and, at the end, the outcome.
-
-Frames are ``speed / fps`` simulated seconds apart, so the video plays at real time x ``speed``.
-The static scene is drawn once and only the moving artists are redrawn per frame (blitting on
-the Agg canvas), which is several times faster than matplotlib's FuncAnimation writers; GIFs are
-written with Pillow, MP4 by piping raw frames to ffmpeg (which must be on the PATH).
+``docs/experiments.md``, "Animations: frames".
 """
 
 from __future__ import annotations

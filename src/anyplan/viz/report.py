@@ -1,21 +1,12 @@
 """Figures and a self-contained, interactive HTML report from a results database (and nothing else).
 
-Figures are made at print size (7.16 in wide, fonts of 8 pt and more; :mod:`anyplan.viz.style`)
-and written as PNG, SVG or PDF (``fmt``):
+Figures are made at print size (:mod:`anyplan.viz.style`) as PNG, SVG or PDF: ``figure4`` (the
+paper's Figure 4 as a grid of representative runs), ``boxplots`` (path length, generation time,
+time to goal and clearance per planner and number of moving obstacles), ``cost_time`` (best cost
+against planning time, ours and OMPL's), then ``tables.md``, ``tables.csv`` and ``report.html``
+(:mod:`anyplan.viz.report_html`).
 
-* ``figure4.png``: the paper's Figure 4 as a grid, rows = planners, columns = scenarios
-  (paper-1..3 when present): each panel is one representative run (the first successful run,
-  else the first run) with its executed path, the obstacles and the virtual obstacles, drawn by
-  :func:`anyplan.viz.run.draw_run`; one time colour bar [s] shared by the panels, one legend.
-* ``boxplots.png``: path length, path generation time, time to goal and minimum clearance per
-  planner and number of moving obstacles.
-* ``cost_time.png``: best cost against planning time from the ``progress`` table, for anytime
-  planners that report it (``source = 'planner'``) and OMPL planners imported into the database
-  (``source`` NULL, e.g. ``geometric_BITstar``, dashed): median over runs with the inter-quartile
-  band, thin lines for single runs; one panel per scenario (all scenarios, small multiples).
-  Without such rows, the lengths of the executed plans against simulated time.
-* ``tables.md``, ``tables.csv`` and ``report.html`` (:mod:`anyplan.viz.report_html`: navigation,
-  sortable tables, plots, drill-down to the runs and their playback; figures embedded as PNG).
+What each figure draws: ``docs/experiments.md``, "Report: the figures".
 """
 
 from __future__ import annotations

@@ -1,29 +1,12 @@
 """Occupancy-grid maps in ROS ``map_server`` format: a YAML file and a PGM or PNG image.
 
-The YAML keys (``docs/scenarios.md``, "Maps"):
+The YAML keys of ROS's ``map_server`` (and Nav2's): ``image`` (PGM ``P2``/``P5`` or PNG),
+``resolution`` [m/pixel], ``origin`` [x, y, yaw] (only yaw = 0), ``negate``,
+``occupied_thresh``, ``free_thresh`` and ``mode`` (``trinary``, ``scale`` or ``raw``). Cell
+values follow map_server; a cell is **free** only when its value is known and its occupancy is
+below ``free_thresh``: every other cell, occupied, uncertain or unknown, is a static obstacle.
 
-* ``image``: the image file, relative to the YAML file (PGM ``P2``/``P5``, any maxval, or PNG:
-  grey, grey+alpha, RGB, RGBA, palette, 16-bit).
-* ``resolution``: cell side [m/pixel], > 0.
-* ``origin``: [x, y, yaw], the pose of the lower-left corner of the lower-left pixel [m, m,
-  rad]. Only yaw = 0 is supported (a rotated grid would make every cell a rotated box);
-  another yaw is refused with a clear error.
-* ``negate`` (0/1), ``occupied_thresh`` and ``free_thresh`` (0 <= free < occupied <= 1).
-* ``mode`` (optional): ``trinary`` (default), ``scale`` or ``raw``.
-
-Cell values follow map_server (as Nav2 computes them). The shade v of a pixel is the mean of
-its colour channels scaled to [0, 255] (alpha excluded); with ``negate`` v becomes 255 - v.
-Then p = (255 - v) / 255 is the occupancy probability and
-
-* ``trinary``: p > occupied_thresh -> 100 (occupied), p < free_thresh -> 0 (free), else -1
-  (unknown);
-* ``scale``: as trinary, but between the thresholds a pixel that is not fully opaque is -1 and
-  an opaque one is 1 + round(98 (p - free) / (occupied - free));
-* ``raw``: the value is round(v) itself when <= 100, else -1 (unknown).
-
-A cell is **free** only when its value is known and its occupancy ``value / 100`` is below
-``free_thresh`` (trinary and scale: exactly the cells of value 0). Every other cell, occupied,
-uncertain or unknown, is a static obstacle.
+Keys and how pixel shades become cell values: ``docs/scenarios.md``, "Maps: cell values".
 """
 
 from __future__ import annotations
