@@ -8,23 +8,50 @@
 * ``gaps``: 20 ``per_count`` gap worlds (:mod:`anyplan.experiments.gaps`) from ``random_seed``;
 * a folder: every ``*.yaml`` / ``*.yml`` file in it, sorted by name;
 * a comma-separated list of scenario files or built-in names.
+
+The named suites are entries of the registry :data:`SUITES`.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from anyplan.errors import AnyplanError
 from anyplan.experiments.generate import random_suite
+from anyplan.registry import Registry
 from anyplan.world.scenario import Scenario, load_scenario
 
-__all__ = ["resolve_suite", "PAPER_SUITE", "SuiteError"]
+__all__ = ["resolve_suite", "PAPER_SUITE", "SUITES", "SuiteError"]
 
 PAPER_SUITE = ("paper-1", "paper-2", "paper-3")
 
 
 class SuiteError(AnyplanError):
     """A suite cannot be resolved to scenarios."""
+
+
+def _paper(random_seed: int, per_count: int) -> list[Scenario]:
+    return [load_scenario(n) for n in PAPER_SUITE]
+
+
+def _random(random_seed: int, per_count: int) -> list[Scenario]:
+    if per_count < 1:
+        raise SuiteError.about("per_count", f" must be >= 1, got {per_count}")
+    return random_suite(random_seed, per_count=per_count)
+
+
+def _gaps(random_seed: int, per_count: int) -> list[Scenario]:
+    from anyplan.experiments.gaps import gap_suite
+
+    return gap_suite(random_seed, n=20 * per_count)
+
+
+#: Named suites: name -> ``(random_seed, per_count) -> scenarios``.
+SUITES: Registry[Callable[[int, int], list[Scenario]]] = Registry("suite")
+SUITES.register("paper", _paper)
+SUITES.register("random", _random)
+SUITES.register("gaps", _gaps)
 
 
 def resolve_suite(suite: str, random_seed: int = 0, per_count: int = 1) -> list[Scenario]:
@@ -34,16 +61,8 @@ def resolve_suite(suite: str, random_seed: int = 0, per_count: int = 1) -> list[
         SuiteError: an empty folder or list, or two scenarios with one name.
         ScenarioError, UnknownNameError: a file or name that does not load.
     """
-    if suite == "paper":
-        scenarios = [load_scenario(n) for n in PAPER_SUITE]
-    elif suite == "random":
-        if per_count < 1:
-            raise SuiteError.about("per_count", f" must be >= 1, got {per_count}")
-        scenarios = random_suite(random_seed, per_count=per_count)
-    elif suite == "gaps":
-        from anyplan.experiments.gaps import gap_suite
-
-        scenarios = gap_suite(random_seed, n=20 * per_count)
+    if suite in SUITES:
+        scenarios = SUITES.get(suite)(random_seed, per_count)
     elif Path(suite).is_dir():
         files = sorted(p for p in Path(suite).iterdir() if p.suffix in (".yaml", ".yml"))
         if not files:
