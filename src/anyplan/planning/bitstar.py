@@ -48,6 +48,7 @@ from typing import Any
 
 import numpy as np
 
+from anyplan.config import setting, validate
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.geometry.shapes import Shape
 from anyplan.planning import _bitstar_core as core
@@ -103,23 +104,16 @@ class BITStarConfig:
         chunk_s: Target wall time [s] between two checks of the termination condition.
     """
 
-    samples_per_batch: int = 400
-    first_batch_samples: int = 0
-    rewire_factor: float = 1.1
-    use_k_nearest: bool = False
-    prune: bool = True
-    chunk_s: float = 2e-4
+    samples_per_batch: int = setting(400, lo=1, doc="samples added per batch")
+    first_batch_samples: int = setting(0, lo=0, doc="samples of the first batch (0: samples_per_batch)")
+    rewire_factor: float = setting(1.1, lo=1.0, hi=3.0, doc="eta, the factor on the RGG radius")
+    use_k_nearest: bool = setting(False, doc="k nearest instead of an r-disc")
+    prune: bool = setting(True, doc="drop what cannot improve the solution")
+    chunk_s: float = setting(2e-4, lo=0.0, lo_open=True, hi=1.0, unit="s",
+                             doc="wall time between termination checks")
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.samples_per_batch, int) and self.samples_per_batch >= 1):
-            raise ValueError(f"samples_per_batch: must be an int >= 1, got {self.samples_per_batch!r}")
-        if not (isinstance(self.first_batch_samples, int) and self.first_batch_samples >= 0):
-            raise ValueError(f"first_batch_samples: must be an int >= 0, got "
-                             f"{self.first_batch_samples!r}")
-        if not (1.0 <= float(self.rewire_factor) <= 3.0):
-            raise ValueError(f"rewire_factor: must be in [1.0, 3.0], got {self.rewire_factor!r}")
-        if not (0.0 < float(self.chunk_s) <= 1.0):
-            raise ValueError(f"chunk_s: must be in (0, 1], got {self.chunk_s!r}")
+        validate(self, owner="")  # messages "rewire_factor: must be in [1, 3], got 5.0"
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,7 @@ from typing import Any
 
 import numpy as np
 
+from anyplan.config import setting, validate
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.geometry.shapes import Shape, square
 from anyplan.planning.bitstar import BITStar, BITStarConfig
@@ -89,34 +90,25 @@ class SequentialConfig:
         bitstar: BIT* settings.
     """
 
-    max_iterations: int = 8
-    first_budget_s: float = 0.005
-    iteration_budget_s: float = 0.002
-    batches_per_plan: int | None = None
-    warm_start: bool = False
-    margin: float = 0.05
-    side_factor: float = 1.0
-    min_side: float = 0.1
-    anchor: str = "robot"
-    wait_delays_s: tuple[float, ...] = (0.5, 1.0, 2.0, 3.0, 5.0, 8.0, 12.0)
-    prediction_dt: float | None = 0.02
-    max_time_s: float = 0.5
+    max_iterations: int = setting(8, lo=1, doc="BIT* plans per replanning")
+    first_budget_s: float = setting(0.005, lo=0.0, lo_open=True, unit="s", doc="first plan's budget")
+    iteration_budget_s: float = setting(0.002, lo=0.0, lo_open=True, unit="s",
+                                        doc="budget after each virtual obstacle")
+    batches_per_plan: int | None = setting(None, lo=1, doc="batch budget instead of a time budget")
+    warm_start: bool = setting(False, doc="continue the previous search")
+    margin: float = setting(0.05, lo=0.0, unit="m", doc="extra clearance from predicted obstacles")
+    side_factor: float = setting(1.0, lo=0.0, lo_open=True, doc="square side / 2 (r + r_o)")
+    min_side: float = setting(0.1, lo=0.0, lo_open=True, unit="m", doc="smallest shrunk side")
+    anchor: str = setting("robot", choices=("robot", "obstacle", "midpoint"), doc="square centre")
+    wait_delays_s: tuple[float, ...] = setting((0.5, 1.0, 2.0, 3.0, 5.0, 8.0, 12.0), lo=0.0,
+                                               lo_open=True, unit="s", doc="departure delays tried")
+    prediction_dt: float | None = setting(0.02, lo=0.0, lo_open=True, unit="s",
+                                          doc="resampling step of the prediction; None: exact")
+    max_time_s: float = setting(0.5, lo=0.0, lo_open=True, unit="s", doc="wall-clock cap of a replanning")
     bitstar: BITStarConfig = field(default_factory=BITStarConfig)
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.max_iterations, int) and self.max_iterations >= 1):
-            raise ValueError(f"max_iterations: must be an int >= 1, got {self.max_iterations!r}")
-        for name in ("first_budget_s", "iteration_budget_s", "side_factor", "min_side", "max_time_s"):
-            if not float(getattr(self, name)) > 0.0:
-                raise ValueError(f"{name}: must be > 0, got {getattr(self, name)!r}")
-        if self.margin < 0.0:
-            raise ValueError(f"margin: must be >= 0, got {self.margin!r}")
-        if self.anchor not in ("robot", "obstacle", "midpoint"):
-            raise ValueError(f"anchor: must be robot, obstacle or midpoint, got {self.anchor!r}")
-        if self.batches_per_plan is not None and self.batches_per_plan < 1:
-            raise ValueError(f"batches_per_plan: must be >= 1, got {self.batches_per_plan!r}")
-        if any(d <= 0.0 for d in self.wait_delays_s):
-            raise ValueError("wait_delays_s: delays must be > 0")
+        validate(self, owner="")  # messages "anchor: must be one of robot, ..., got 'x'"
 
 
 @dataclass(frozen=True)
