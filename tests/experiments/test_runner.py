@@ -46,11 +46,11 @@ def test_tiny_bench_stores_every_run_with_its_seed(tmp_path, tiny_file):
             assert r["scenario_hash"] == sc.content_hash()
             assert r["anyplan_version"]
             assert r["outcome"] == "reached" and r["solved"] == 1 and r["status"] == 6
-            res = db.result(r["id"])
+            res = db.run_result(r["id"])
             # The whole result.json is kept, and agrees with the run's columns.
-            assert res["seed"] == r["seed"] and res["planner"] == r["planner"]
-            assert res["path_length_m"] == pytest.approx(r["path_length"])
-            assert len(res["trajectory"]) > 10
+            assert res.seed == r["seed"] and res.planner == r["planner"]
+            assert res.path_length_m == pytest.approx(r["path_length"])
+            assert len(res.trajectory) > 10
         # Half speed takes about twice as long over the same 5 m.
         ttg = {r["planner"]: r["time_to_goal"] for r in runs if r["run_index"] == 0}
         assert ttg["half-speed"] > 1.6 * ttg["straight"]

@@ -1,24 +1,15 @@
-"""An agent's settings, for the command line: ``--set KEY=VALUE`` and ``--deterministic``.
+"""An agent's settings: what ``--set KEY=VALUE`` and ``--deterministic`` may change.
 
-The settings of an agent class are the keyword arguments of its ``__init__`` whose annotated type
-is a scalar (``float``, ``int``, ``bool``, ``str``, ``None``, a union of those, or a
-``tuple[float, ...]``), plus the fields of the dataclasses named in its ``config_classes``
-attribute (for ``seq-bitstar``, :class:`~anyplan.planning.sequential.SequentialConfig`; for
-``dovs``, :class:`~anyplan.baselines.dovs.config.DOVSConfig`): what it accepts as keywords through
-``**options``; an entry of ``config_classes`` may be a config instance, whose values are then
-the agent's defaults. Config fields declared with :func:`anyplan.config.setting` are listed
-with their range, unit and description. This works for plugins too: their ``__init__`` signature
-is read the same way.
-
-``VALUE`` is parsed as a YAML scalar (``0.1``, ``2``, ``true``, ``null``, ``measured``,
-``[0.5, 1.0]``) and checked against the setting's type; an unknown key is refused with the
-nearest known one as a hint. Range checks are the agent's own (its constructor's
-``ValueError``), turned into one-line errors by :func:`build_agent_config`.
-
-``--deterministic`` applies the class's ``deterministic_settings`` (for ``seq-bitstar``: a
-fixed planning delay, a batch budget instead of a time budget, and a wall-clock cap far above
-any planning time): the run then depends only on the scenario, the settings and the seed, not
-on the machine's speed. An agent class without that attribute has no such mode.
+The settings of an agent class are its ``__init__``'s scalar keywords (``float``, ``int``,
+``bool``, ``str``, ``None``, unions of those, ``tuple[float, ...]``; read through ``**kwargs``
+to the base classes, so plugins work too) plus the fields of its ``config_classes`` (a config
+class, or a config instance whose values are the agent's defaults), listed with their range,
+unit and description when declared with :func:`anyplan.config.setting`. Values are parsed as
+YAML scalars and checked against the setting's type, an unknown key is refused with the nearest
+known one, and range checks are the agent's own (turned into one-line errors by
+:func:`build_agent_config`). ``deterministic_settings`` make a run depend only on the scenario,
+the settings and the seed. Errors name ``setting`` / ``deterministic``; the command line tells
+them as ``--set`` / ``--deterministic``.
 """
 
 from __future__ import annotations

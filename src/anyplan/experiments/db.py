@@ -1,34 +1,14 @@
 """The results database: one SQLite file in the layout of OMPL's benchmark database.
 
-OMPL's ``ompl_benchmark_statistics.py`` (and so Planner Arena) reads a database of five tables;
-we write the same tables with the same required columns, and add our own columns where OMPL
-allows it (extra experiment properties, extra run properties, extra progress properties):
-
-* ``experiments``: one row per (scenario content, master seed, simulation settings). OMPL's
-  columns (``name`` = scenario name, ``version`` = ``"anyplan X.Y.Z"``, ``seed`` = master seed,
-  ``timelimit`` = simulated time limit [s], ``runcount`` = runs per planner, ``setup`` = the
-  scenario as JSON, so figures can be redrawn from the database alone) plus ``scenario_hash``,
-  ``moving_obstacles``, ``suite``, ``sim_dt``.
-* ``plannerConfigs``: ``name`` = registry name, ``settings`` = the agent's keyword config as
-  ``"key = value;"`` lines (OMPL's convention), empty for the defaults.
-* ``enums``: OMPL's ``status`` values 0-9 plus our value 10, ``Collision``.
-* ``runs``: OMPL's ``status``, ``solved``, ``time`` (total planning wall time [s]),
-  ``best_cost`` and ``solution_length`` (executed path length [m], NULL unless solved),
-  ``approximate_solution``, ``correct_solution``, ``memory``; plus ours (see ``RUN_COLUMNS``).
-* ``progress``: ``(runid, time, best_cost)`` as in OMPL, plus ``plan_index`` and ``source``:
-  ``source = 'planner'`` rows are an anytime planner's cost [m] against planning time [s] (from
-  ``result.extra["progress"] = [[time_s, cost_m], ...]``, OMPL's meaning); ``source = 'plans'``
-  rows are the executed plans' lengths [m] against the simulated time [s] they were made
-  (``result.plans``). OMPL's own rows (imported logs) have ``source`` NULL.
-
-And one table of our own, ``results(runid, encoding, data)``: the whole ``result.json`` of the
-run (trajectory, plans, virtual obstacles), zlib-compressed JSON.
-
-Only the coordinating process opens the database for writing; each finished run is committed in
-its own transaction, so an interruption loses no finished run. One process at a time may open a
-database for writing (a lock, :class:`~anyplan.experiments.dbfile.WriterLock`); a file that is
-not an anyplan database is refused and never modified; a run's key ``(experimentid, plannerid,
-run_index, seed)`` is UNIQUE in the schema itself, so no run is ever stored twice.
+OMPL's ``ompl_benchmark_statistics.py`` (and so Planner Arena) reads its five tables
+(``experiments``, ``plannerConfigs``, ``enums``, ``runs``, ``progress``); we write the same
+tables with the same required columns plus our own, and one table of our own, ``results``: the
+whole ``result.json`` of each run, zlib-compressed (read back with :meth:`ResultsDB.run_result`,
+through :meth:`~anyplan.simulation.RunResult.from_dict`). Only the coordinating process writes,
+one committed transaction per finished run, under a writer lock
+(:class:`~anyplan.experiments.dbfile.WriterLock`); a file that is not an anyplan database is
+refused and never modified; a run's key ``(experimentid, plannerid, run_index, seed)`` is
+UNIQUE in the schema. Tables and columns: ``docs/experiments.md``, "The results database".
 """
 
 from __future__ import annotations

@@ -1,22 +1,15 @@
 """The benchmark runner: every (scenario, planner, run) in parallel, results into the database.
 
-Work is split into :class:`RunTask` objects (picklable: the validated scenario, its content
+Work is split into :class:`RunTask` objects (picklable: the validated scenario and its content
 hash, the validated :class:`~anyplan.simulation.SimConfig`, the planner's registry name and
-config, the seed). Settings are validated once, at the edge: the scenario when it is loaded and
-the simulation settings in :func:`run_bench`; a worker neither re-parses nor re-hashes them. A
-task is executed by the top-level function :func:`execute_task`, which is safe for ``spawn``
-worker processes and Dask workers alike: it builds the agent inside the worker and returns the
-whole ``result.json`` dictionary (or the planner's error). Only the coordinating process writes the
-database, one committed transaction per finished run, so Ctrl-C, a killed worker or a crash of
-the coordinator loses no finished run, and ``resume=True`` runs only the missing ones.
-
-Seeds: run ``i`` of every scenario and planner uses ``derive_seed(master_seed, i)`` (common
-random numbers across planners and scenarios); the per-run seed is recorded in ``runs.seed``
-and the master seed in ``experiments.seed``.
-
-Backends: in-process (``jobs=1``), a ``concurrent.futures.ProcessPoolExecutor`` with the spawn
-start method (``jobs>1``), or a Dask cluster (``scheduler="tcp://host:port"``, optional extra
-``anyplan[dask]``).
+config, the seed): settings are validated once, at the edge, and a worker neither re-parses nor
+re-hashes them. :func:`execute_task` (safe for ``spawn`` workers and Dask alike) builds the agent
+and returns the whole ``result.json`` dictionary or the planner's error. Only the coordinating
+process writes the database, one transaction per finished run, so an interruption loses no
+finished run and ``resume=True`` runs only the missing ones. Run ``i`` uses the seed
+``derive_seed(master_seed, i)`` (common random numbers). Backends: in-process (``jobs=1``), a
+spawn ``ProcessPoolExecutor`` (``jobs>1``) or a Dask cluster (``scheduler=...``, extra
+``anyplan[dask]``). See ``docs/experiments.md``.
 """
 
 from __future__ import annotations

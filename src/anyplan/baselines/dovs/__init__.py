@@ -1,9 +1,9 @@
 """DOVS-Greedy: the Dynamic Object Velocity Space planner used as the paper's baseline.
 
 Lorente, Owen & Montano, "Model-based robocentric planning and navigation for dynamic
-environments", IJRR 37(8):867-889, 2018. Written from the specification in
-``shared/research/dovs.md`` (the analytic per-ray DOV model with the greedy selector); see
-``docs/dovs.md`` for the model, the parameters and the deviations from the authors' code.
+environments", IJRR 37(8):867-889, 2018: the analytic per-ray DOV model with the greedy
+selector. See ``docs/dovs.md`` for the model, the parameters and the deviations from the
+authors' code.
 
 Modules: :mod:`.config` (parameters), :mod:`.model` (robocentric transforms, collision bands,
 per-ray forbidden intervals, static braking), :mod:`.window` (velocity space and dynamic

@@ -1,37 +1,16 @@
 """The Dynamic Object Velocity Space model: per-ray forbidden speed intervals.
 
 Lorente, Owen & Montano, "Model-based robocentric planning and navigation for dynamic
-environments", IJRR 37(8), 2018; written from the description in ``shared/research/dovs.md`` §2
-(no code of the authors' implementation is reused).
+environments", IJRR 37(8), 2018 (no code of the authors' implementation is reused).
 
 Every control period the obstacles are expressed in the robot frame (robot at the origin,
-heading +x; frozen during the prediction; obstacles keep their absolute twist). A command (v, w)
-held constant drives the arc of curvature kappa = w / v, P(s) = (sin(kappa s), 1 - cos(kappa s))
-/ kappa, at speed v: every command on the *ray* of curvature kappa follows the same path.
-
-* A **linear** obstacle (speed v_o, heading theta_o) sweeps the strip |eta| <= R (eta the lateral
-  coordinate from its track, R = rho_o + 1.1 rho_robot); a **circular** one sweeps the annulus
-  |rho| - R <= |p - c_o| <= |rho| + R around its turning centre.
-* Each arc is cut into *stretches* [s_a, s_b] inside the band, using all crossings up to the arc
-  length ``v_max(ray) * T_h``. The crossings solve cos(phi - gamma) in [c_lo, c_hi] for the arc
-  angle phi = kappa s, in closed form for both band types.
-* The obstacle, lengthened to half-length R along its track (a rectangle or an annular sector
-  containing the disc), occupies the stretch only during [t_in, t_out]: for a linear obstacle
-  t_in = max(0, xi_min - R) / v_o and t_out = (xi_max + R) / v_o, xi the along-track coordinate,
-  its exact extremes over the stretch; for a circular one the same with the polar angle about
-  c_o (half-width asin(R / |rho|), every pass within the horizon).
-* The robot is through before the obstacle arrives iff v >= s_b / t_in and enters after it
-  leaves iff v <= s_a / t_out, so the forbidden speeds on the ray are the closed interval
-  [s_a / t_out, s_b / t_in], clipped to the velocity space. Conflicts with t_in > T_h are dropped.
-* **Static** obstacles (and observed obstacles slower than 0.1 m/s) forbid, on each ray, the
-  speeds from which the robot cannot brake before the first contact at arc length s_hit:
-  v > sqrt(2 a (s_hit - d_safe)). Map shapes enter only within the safe distance D_safe; their
-  first contact is found by sphere tracing with the exact clearance kernels (a certified lower
-  bound on s_hit).
-
-Because each stretch's occupancy window contains every instant at which the inflated disc can
-touch it, the union of the intervals contains every colliding (v, w) of the horizon: the model
-is conservative (tested against brute-force simulation in ``tests/baselines``).
+heading +x). A command (v, w) held constant drives the arc of curvature kappa = w / v; every
+command on that *ray* follows the same path. Moving obstacles (linear or circular) forbid on
+each ray the closed speed interval [s_a / t_out, s_b / t_in] of every arc stretch [s_a, s_b]
+they occupy during [t_in, t_out]; static ones forbid the speeds v > sqrt(2 a (s_hit - d_safe))
+from which the robot cannot brake before the first contact at arc length s_hit. The model is
+conservative (tested against brute-force simulation in ``tests/baselines``). Derivation: the
+section "The model (one control period)" of ``docs/dovs.md``.
 """
 
 from __future__ import annotations

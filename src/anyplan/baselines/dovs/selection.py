@@ -1,7 +1,7 @@
 """Goal velocities, the static braking rule and the greedy command selector of DOVS.
 
-Follows the description of the authors' "Greedy" planner in ``shared/research/dovs.md`` §3.2-3.3
-(Lorente, Owen & Montano, IJRR 2018, and their public code), written from that description:
+Follows the authors' "Greedy" planner (Lorente, Owen & Montano, IJRR 2018, and their public
+code; described in ``docs/dovs.md``), written from its description:
 
 1. the target command is "FollowGoal": the command reaching the goal in one period if it is
    admissible, else the fastest command on the goal arc within ``goal_switch_distance`` of the

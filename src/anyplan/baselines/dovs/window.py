@@ -1,8 +1,8 @@
 """Velocity space (VS) and dynamic window (DW) of DOVS, in the (omega, v) plane.
 
 * The VS is v in [0, v_max] and, by default, the triangle v <= v_max (1 - |omega| / omega_max)
-  of a differential drive's wheel-speed limits (Lorente, Owen & Montano, IJRR 2018; the
-  authors' code, ``shared/research/dovs.md`` §2.1).
+  of a differential drive's wheel-speed limits (Lorente, Owen & Montano, IJRR 2018, and the
+  authors' code; ``docs/dovs.md``).
 * A constant command (v, omega) with v > 0 drives the arc of curvature kappa = omega / v; all
   commands on the *ray* v = omega / kappa follow the same path at different speeds. The largest
   VS speed on a ray is :func:`ray_v_max`.
