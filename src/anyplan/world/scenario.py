@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import weakref
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from importlib import resources
@@ -80,16 +81,28 @@ class Scenario:
         """The static obstacles, the map's blocked cells (merged into boxes) and the arena
         walls, for exact clearance queries: built once per scenario and cached on it (shared by
         :meth:`static_only`; not pickled, a worker builds its own once)."""
-        cached = self.__dict__.get("_obstacle_set")
+        cache = _cache(self)
+        cached = cache.get("obstacle_set")
         if cached is None:
             shapes = [o.shape for o in self.static_obstacles]
             cached = (ObstacleSet(shapes, bounds=self.bounds) if self.static_map is None
                       else self.static_map.obstacle_set(shapes, self.bounds))
-            self.__dict__["_obstacle_set"] = cached  # a frozen dataclass: a cache, not a field
+            cache["obstacle_set"] = cached
         return cached
 
     def __getstate__(self) -> dict[str, Any]:
-        return {k: v for k, v in self.__dict__.items() if k != "_obstacle_set"}
+        """The fields, and the content hash if computed (a worker need not hash again)."""
+        state = dict(self.__dict__)
+        if "content_hash" in _cache(self):
+            state[_HASH_KEY] = _cache(self)["content_hash"]
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        state = dict(state)
+        digest = state.pop(_HASH_KEY, None)
+        self.__dict__.update(state)
+        if digest is not None:
+            _cache(self)["content_hash"] = digest
 
     def nearest_static(self, a: Sequence[float] | np.ndarray,
                        b: Sequence[float] | np.ndarray | None = None) -> str:
@@ -112,8 +125,8 @@ class Scenario:
     def static_only(self) -> Scenario:
         """The same scenario without its moving obstacles (what a static planner knows)."""
         out = replace(self, moving_obstacles=())
-        if "_obstacle_set" in self.__dict__:
-            out.__dict__["_obstacle_set"] = self.__dict__["_obstacle_set"]
+        if "obstacle_set" in _cache(self):
+            _cache(out)["obstacle_set"] = _cache(self)["obstacle_set"]
         return out
 
     def to_dict(self) -> dict[str, Any]:
@@ -145,14 +158,30 @@ class Scenario:
     def content_hash(self) -> str:
         """SHA-256 (hex, 16 chars) of the scenario's canonical JSON, ignoring its source;
         computed once per scenario and cached on it."""
-        cached = self.__dict__.get("_content_hash")
+        cache = _cache(self)
+        cached = cache.get("content_hash")
         if cached is None:
             d = self.to_dict()
             if self.static_map is not None:
                 d["static_map"] = self.static_map.digest()  # the content, not where it lives
             blob = json.dumps(d, sort_keys=True, default=float).encode()
-            cached = self.__dict__["_content_hash"] = hashlib.sha256(blob).hexdigest()[:16]
+            cached = cache["content_hash"] = hashlib.sha256(blob).hexdigest()[:16]
         return str(cached)
+
+
+#: Per-scenario caches (content hash, obstacle set) by ``id``, dropped with the scenario: the
+#: frozen dataclass's ``__dict__`` keeps its fields only (``Scenario(**sc.__dict__)`` works).
+_CACHES: dict[int, dict[str, Any]] = {}
+_HASH_KEY = "__content_hash__"
+
+
+def _cache(sc: Scenario) -> dict[str, Any]:
+    key = id(sc)
+    cache = _CACHES.get(key)
+    if cache is None:
+        cache = _CACHES[key] = {}
+        weakref.finalize(sc, _CACHES.pop, key, None)
+    return cache
 
 
 def _plain(obj: Any) -> Any:
