@@ -1,7 +1,8 @@
 """Benchmark: our BIT* against OMPL's BITstar, InformedRRTstar and RRTstar (issue 3).
 
-Problems: the paper scenarios without their moving obstacles, the shared problem of
-``shared/research/peers.md`` §1 (point robot and a 0.25 m disc), and random cluttered 15 x 11 m
+Problems: the paper scenarios without their moving obstacles, the peers' problem
+(``benchmarks/scenarios/peers.yaml``: 15 x 11 m, two walls from the border and a block; point
+robot and a 0.25 m disc; exact point-robot optimum 22.233237 m), and random cluttered 15 x 11 m
 worlds (P3-DX radius 0.3 m), half of them with long walls that force detours. The reference is
 the visibility-graph lower bound (:func:`anyplan.planning.visgraph.lower_bound`, inscribed
 rounded corners), so every ratio below is >= the true ratio to the optimum (the feasible
@@ -12,7 +13,7 @@ the benchmark does it around OMPL's calls) and a collection runs before every ru
 collection triggered by earlier runs does not land in someone's budget.
 
 OMPL (the optional ``ompl`` wheel) gets the same exact checks as our planner: a Python
-``StateValidityChecker`` and an exact segment ``MotionValidator`` (peers.md §3.1), both calling
+``StateValidityChecker`` and an exact segment ``MotionValidator`` (one call per edge), both calling
 :class:`~anyplan.geometry.collision.ObstacleSet`'s compiled kernels. Each OMPL run uses two
 planner instances: one stopped at its first solution (cost threshold 1e9) for the time to the
 first solution, and one resumed to 10, 50, 100 and 500 ms of wall time (cumulative ``solve``
@@ -163,7 +164,7 @@ def run_ours(problem: Problem, seed: int, opt: float, cap_s: float, **cfg) -> Ru
 
 
 class OMPLRunner:
-    """OMPL planners on one problem with exact validity checks (peers.md §3.1)."""
+    """OMPL planners on one problem with the same exact validity checks as ours."""
 
     def __init__(self, problem: Problem) -> None:
         from ompl import base as ob
