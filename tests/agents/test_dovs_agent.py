@@ -86,7 +86,7 @@ def test_runs_are_deterministic() -> None:
 def test_agent_rejects_unknown_parameters() -> None:
     with pytest.raises(DOVSConfigError, match="unknown parameter"):
         make_agent("dovs", horizon=3.0)
-    with pytest.raises(DOVSConfigError, match="DOVSConfig.time_horizon_s"):
+    with pytest.raises(DOVSConfigError, match=r"DOVSConfig\.time_horizon_s"):
         make_agent("dovs", time_horizon_s=-1.0)
 
 

@@ -64,7 +64,7 @@ def cmd_dovs_plot(args: argparse.Namespace) -> int:
     """Simulate DOVS up to ``--time`` and draw its decision there."""
     from anyplan.agents.base import Observation
     from anyplan.agents.dovs import DOVSAgent
-    from anyplan.simulation.simulator import SimConfig, observe, simulate
+    from anyplan.simulation.simulator import RunStatus, SimConfig, observe, simulate
     from anyplan.world.robot import RobotState
     from anyplan.world.scenario import load_scenario
 
@@ -86,7 +86,7 @@ def cmd_dovs_plot(args: argparse.Namespace) -> int:
     if t_req > 0.0:
         result = simulate(scenario, agent, seed=args.seed, config=SimConfig(time_limit=t_req))
         traj = result.trajectory_array
-        if result.status != "timeout":
+        if result.status != RunStatus.TIMEOUT:
             note = f"(the run ended at t = {traj[-1, 0]:.2f} s: {result.status}; drawn there)"
     else:
         import numpy as np
