@@ -11,6 +11,9 @@ from anyplan.world.sensing import DEFAULT_NOISE_M, DEFAULT_RATE_HZ, MODES
 
 __all__ = ["add_perception_options", "apply_perception"]
 
+#: :class:`~anyplan.world.sensing.SensingSpec` fields -> the flags that set them.
+_FLAGS = {"mode": "--perception", "noise_m": "--sensor-noise", "rate_hz": "--sensor-rate"}
+
 
 def add_perception_options(p: argparse.ArgumentParser) -> None:
     """Add ``--perception``, ``--sensor-noise`` and ``--sensor-rate`` to ``p``."""
@@ -37,7 +40,6 @@ def apply_perception(command: str, scenarios: Sequence[Scenario],
     try:
         return [override_sensing(sc, args.perception, args.sensor_noise, args.sensor_rate)
                 for sc in scenarios]
-    except ValueError as exc:
-        opt = ("--perception" if "mode" in str(exc) else
-               "--sensor-noise" if "noise" in str(exc) else "--sensor-rate")
+    except ValueError as exc:  # a SensingError names its field; the flag is told here
+        opt = _FLAGS.get(getattr(exc, "field", ""), "--perception")
         raise UsageError(f"{command}: {opt}: {exc}") from None

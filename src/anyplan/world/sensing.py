@@ -18,7 +18,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["MODES", "SensingSpec", "DEFAULT_NOISE_M", "DEFAULT_RATE_HZ"]
+from anyplan.errors import AnyplanError
+
+__all__ = ["MODES", "SensingSpec", "SensingError", "DEFAULT_NOISE_M", "DEFAULT_RATE_HZ"]
 
 #: Known perception modes.
 MODES = ("oracle", "twist", "tracked")
@@ -26,6 +28,14 @@ MODES = ("oracle", "twist", "tracked")
 DEFAULT_NOISE_M = 0.05
 #: Default detection rate [Hz] of ``tracked``.
 DEFAULT_RATE_HZ = 10.0
+
+
+class SensingError(AnyplanError, ValueError):
+    """A bad perception setting; ``field`` names it (``mode``, ``noise_m`` or ``rate_hz``)."""
+
+    def __init__(self, field: str, message: str) -> None:
+        self.field = field
+        super().__init__(message)
 
 
 @dataclass(frozen=True)
@@ -38,7 +48,7 @@ class SensingSpec:
         rate_hz: Detection rate [Hz] (``tracked``).
 
     Raises:
-        ValueError: an unknown mode, a negative or non-finite noise, a rate that is not > 0.
+        SensingError: an unknown mode, a negative or non-finite noise, a rate that is not > 0.
     """
 
     mode: str = "oracle"
@@ -47,14 +57,14 @@ class SensingSpec:
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
-            raise ValueError(f"unknown perception mode '{self.mode}' (known: {', '.join(MODES)})")
+            raise SensingError("mode", f"unknown perception mode '{self.mode}' (known: {', '.join(MODES)})")
         from anyplan.world.limits import MAX_SENSOR_RATE_HZ, MAX_SIZE_M
 
         if not (math.isfinite(self.noise_m) and 0.0 <= self.noise_m <= MAX_SIZE_M):
-            raise ValueError(f"sensor noise must be >= 0 m and <= {MAX_SIZE_M:g} m, got "
+            raise SensingError("noise_m", f"sensor noise must be >= 0 m and <= {MAX_SIZE_M:g} m, got "
                              f"{self.noise_m:g}")
         if not (math.isfinite(self.rate_hz) and 0.0 < self.rate_hz <= MAX_SENSOR_RATE_HZ):
-            raise ValueError(f"sensor rate must be > 0 Hz and <= {MAX_SENSOR_RATE_HZ:g} Hz, got "
+            raise SensingError("rate_hz", f"sensor rate must be > 0 Hz and <= {MAX_SENSOR_RATE_HZ:g} Hz, got "
                              f"{self.rate_hz:g}")
 
     def to_dict(self) -> dict[str, float | str]:
