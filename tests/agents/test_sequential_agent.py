@@ -136,7 +136,7 @@ def test_a_slow_first_plan_keeps_the_robot_at_rest_until_it_is_ready():
     agent = SlowAgent()
     res = simulate(sc, agent, seed=0)
     assert res.planning_times_s[0] >= 0.4
-    assert agent.stats.extra["late_plans"] >= 1
+    assert agent.stats.record.late_plans >= 1
     t_start = res.plans[0]["t_start"]
     assert t_start >= 0.4 - 1e-9
     tr = res.trajectory_array

@@ -40,8 +40,8 @@ def _head_on_gap():
 
 
 def _fixed():
-    return dict(planning_delay=0.1, config=SequentialConfig(max_iterations=8, wait_delays_s=(),
-                                                            batches_per_plan=2, max_time_s=10.0))
+    return {"planning_delay": 0.1, "config": SequentialConfig(max_iterations=8, wait_delays_s=(),
+                                                            batches_per_plan=2, max_time_s=10.0)}
 
 
 def test_registered():

@@ -24,8 +24,9 @@ def _loop(scenario, cfg=None, seed=0):
         # The robot is at rest at the start: waiting is simply departing later.
         return plan_motion(path, spec, state, obst, delay, margin=0.015)
 
-    loop = SequentialBITStar(obstacles, spec.radius, spec.radius + 0.03, motion_fn,
-                             cfg or SequentialConfig(), np.random.default_rng(seed))
+    loop = SequentialBITStar(obstacles, robot_radius=spec.radius, plan_radius=spec.radius + 0.03,
+                             motion=motion_fn, config=cfg or SequentialConfig(),
+                             rng=np.random.default_rng(seed))
     preds = ConstantTwistPredictor().predict(observe(scenario, 0.0, state))
     return loop, preds, state
 
@@ -95,8 +96,8 @@ def test_unreachable_goal_is_a_clear_failure():
         raise AssertionError("no path exists, so no motion is built")
 
     cfg = SequentialConfig(first_budget_s=0.05)
-    loop = SequentialBITStar(obst, spec.radius, spec.radius + 0.03, motion_fn, cfg,
-                             np.random.default_rng(0))
+    loop = SequentialBITStar(obst, robot_radius=spec.radius, plan_radius=spec.radius + 0.03,
+                             motion=motion_fn, config=cfg, rng=np.random.default_rng(0))
     res = loop.replan(np.array(spec.start[:2]), np.array(spec.goal), [], 0.0)
     assert res.status == "plan_failed" and res.motion is None and len(res.path) == 0
 

@@ -1,11 +1,19 @@
-"""The agent interface shared by every planner run in the simulator."""
+"""The agent interface shared by every planner run in the simulator.
+
+An :class:`Agent` is reset once per run with the static part of a scenario and then asked for a
+command at every control step (:meth:`Agent.act`, given an :class:`Observation`). What it reports
+goes into :class:`AgentStats`: the common fields, plus a typed statistics record per agent
+(:class:`~anyplan.agents.stats.StatsRecord`, e.g. ``SequentialStats``) that becomes
+``result.json``'s ``extra``. :data:`AGENTS` is the registry of planner names
+(:func:`make_agent`); plugins register through the entry-point group ``anyplan.agents``.
+"""
 
 from __future__ import annotations
 
 import abc
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -48,7 +56,8 @@ class AgentStats:
         virtual_obstacles: Virtual static obstacles created, as dicts
             ``{center: [x, y], side, created_at_s}``.
         plans: Planned paths, as dicts ``{t: creation time [s], path: [[x, y], ...]}``.
-        extra: Further method-specific fields.
+        extra: Further fields without a record (plugins; a value may be a record too).
+        record: The agent's typed statistics (its ``to_dict()`` comes first in ``result.extra``).
     """
 
     planning_times_s: list[float] = field(default_factory=list)
@@ -56,12 +65,29 @@ class AgentStats:
     virtual_obstacles: list[dict[str, Any]] = field(default_factory=list)
     plans: list[dict[str, Any]] = field(default_factory=list)
     extra: dict[str, Any] = field(default_factory=dict)
+    record: Any = None
+
+    def extra_dict(self) -> dict[str, Any]:
+        """``result.json``'s ``extra``: the record's fields, then :attr:`extra` (records in it
+        as their ``to_dict()``)."""
+        out: dict[str, Any] = self.record.to_dict() if self.record is not None else {}
+        for k, v in self.extra.items():
+            out[k] = v.to_dict() if hasattr(v, "to_dict") else v
+        return out
+
+
+class TrackedStats(Protocol):
+    """A record with the tracking error fields that :meth:`TrackingLog.add` writes."""
+
+    tracking_rms_m: float | None
+    tracking_max_m: float | None
 
 
 class TrackingLog:
     """Running RMS and maximum distance [m] between the robot and its reference position.
 
-    :meth:`add` writes ``tracking_rms_m`` and ``tracking_max_m`` into an agent's ``stats.extra``.
+    :meth:`add` writes ``tracking_rms_m`` and ``tracking_max_m`` into an agent's record (or a
+    dict).
     """
 
     def __init__(self) -> None:
@@ -69,14 +95,19 @@ class TrackingLog:
         self._n = 0
         self._max = 0.0
 
-    def add(self, reference_xy: tuple[float, float], robot: RobotState, extra: dict[str, Any]) -> None:
+    def add(self, reference_xy: tuple[float, float], robot: RobotState,
+            into: TrackedStats | dict[str, Any]) -> None:
         """Record one control step's error."""
         err = math.hypot(reference_xy[0] - robot.x, reference_xy[1] - robot.y)
         self._sq += err * err
         self._n += 1
         self._max = max(self._max, err)
-        extra["tracking_rms_m"] = math.sqrt(self._sq / self._n)
-        extra["tracking_max_m"] = self._max
+        if isinstance(into, dict):
+            into["tracking_rms_m"] = math.sqrt(self._sq / self._n)
+            into["tracking_max_m"] = self._max
+        else:
+            into.tracking_rms_m = math.sqrt(self._sq / self._n)
+            into.tracking_max_m = self._max
 
 
 class Agent(abc.ABC):
@@ -94,7 +125,7 @@ class Agent(abc.ABC):
     #: Settings that make a run depend only on scenario, settings and seed (``--deterministic``);
     #: ``{}`` for an agent that is deterministic as it is, None for one without such a mode.
     deterministic_settings: dict[str, Any] | None = None
-    #: Keys of ``stats.extra`` that hold wall-clock measurements (they differ from run to run).
+    #: Keys of ``result.extra`` that hold wall-clock measurements (they differ from run to run).
     wall_clock_extra: tuple[str, ...] = ()
 
     def __init__(self) -> None:

@@ -19,10 +19,12 @@ import time
 
 import numpy as np
 
-from anyplan.agents.base import Agent, Observation, TrackingLog
+from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
+from anyplan.agents.stats import BITStarStats
 from anyplan.agents.warmup import warm_up_kernels
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
 from anyplan.trajectory.motion import plan_motion
+from anyplan.trajectory.reference import state_at
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import Command, RobotState
 from anyplan.world.scenario import Scenario
@@ -45,7 +47,7 @@ class BITStarAgent(Agent):
     name = "bitstar"
     #: Kernel parts this agent uses (:func:`~anyplan.agents.warmup.warm_up_kernels`).
     kernel_parts = ("bitstar", "motion")
-    wall_clock_extra = ("bitstar_time_s", "motion_time_s", "progress")
+    wall_clock_extra = BITStarStats.WALL_CLOCK
 
     def __init__(self, time_budget_s: float = 0.5, plan_margin: float = 0.03,
                  smooth_margin: float = 0.015, max_attempts: int = 3,
@@ -66,10 +68,9 @@ class BITStarAgent(Agent):
         self.trajectory: Trajectory | None = None
 
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
-        from anyplan.agents.base import AgentStats
-
         warm_up_kernels(self.kernel_parts)  # compile or load now, not inside the timed planning
-        self.stats = AgentStats()
+        self.record = BITStarStats()
+        self.stats = AgentStats(record=self.record)
         self.scenario = scenario
         self.spec = scenario.robot
         self.obstacles = scenario.obstacle_set()
@@ -102,7 +103,7 @@ class BITStarAgent(Agent):
         if res is None or not res.solved:
             self.stats.planning_times_s.append(t1 - t0)
             self.failed = True
-            self.stats.extra["plan_status"] = None if res is None else res.status.value
+            self.record.plan_status = None if res is None else res.status.value
             return
         path = np.asarray(res.path, dtype=float)
         traj = plan_motion(path, spec, r, self.obstacles, obs.t, margin=smooth_margin)
@@ -110,20 +111,19 @@ class BITStarAgent(Agent):
         self.trajectory = traj
         self.stats.planning_times_s.append(t2 - t0)
         self.stats.plans.append({"t": obs.t, "path": path.tolist()})
-        self.stats.extra.update({
-            "plan_status": res.status.value,
-            "bitstar_time_s": t1 - t0,
-            "motion_time_s": t2 - t1,
-            "path_cost_m": float(res.cost),
-            "trajectory_kind": traj.kind,
-            "trajectory_certified_free": traj.certified_free,
-            "smoothed_length_m": traj.length,
-            "reference_duration_s": traj.duration,
-            "time_lower_bound_s": traj.lower_bound_s,
-            "smoothed_path": traj.path[:: max(1, len(traj.path) // 400)].tolist(),
-            # BIT*'s cost against its own solve time, [[t_s, cost_m], ...] (OMPL's progress).
-            "progress": [[float(t), float(c)] for t, c in res.history],
-        })
+        rec = self.record
+        rec.plan_status = res.status.value
+        rec.bitstar_time_s = t1 - t0
+        rec.motion_time_s = t2 - t1
+        rec.path_cost_m = float(res.cost)
+        rec.trajectory_kind = traj.kind
+        rec.trajectory_certified_free = traj.certified_free
+        rec.smoothed_length_m = traj.length
+        rec.reference_duration_s = traj.duration
+        rec.time_lower_bound_s = traj.lower_bound_s
+        rec.smoothed_path = traj.path[:: max(1, len(traj.path) // 400)].tolist()
+        # BIT*'s cost against its own solve time, [[t_s, cost_m], ...] (OMPL's progress).
+        rec.progress = [[float(t), float(c)] for t, c in res.history]
 
     # --- control ------------------------------------------------------------------------------
     def act(self, obs: Observation) -> Command:
@@ -135,12 +135,12 @@ class BITStarAgent(Agent):
         traj = self.trajectory
         if traj is None:
             return Command(0.0, 0.0)
-        ref = traj.state(obs.t)
-        self.tracking.add((ref.x, ref.y), obs.robot, self.stats.extra)
+        ref = state_at(traj, obs.t)
+        self.tracking.add((ref.x, ref.y), obs.robot, self.record)
         return self.controller.command(traj, obs.robot, obs.t)
 
     def reference_state(self, t: float) -> RobotState | None:
         """The reference state at time ``t`` [s], or None before planning."""
         if self.trajectory is None:
             return None
-        return self.trajectory.state(t)
+        return state_at(self.trajectory, t)

@@ -18,11 +18,11 @@ wrapper asks the inner agent to replan (``request_replan(reason)``, if it has on
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
 from anyplan.agents.base import Agent, AgentStats, Observation
+from anyplan.agents.stats import TrackerCounts
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
 from anyplan.prediction.tracking import Tracker, TrackerConfig
 from anyplan.prediction.uncertain import UncertaintyModel
@@ -98,7 +98,6 @@ class TrackingAgent(Agent):
         if n != self._plans:
             self._plans = n
             self._tube = {p.name: p for p in self._predictor.predict(seen)}
-        ex: dict[str, Any] = self.inner.stats.extra
-        ex["tracking"] = {"tracks": len(self.tracker), "dropped": self.tracker.dropped,
-                          "tube_exits": self.tube_exits}
+        self.inner.stats.extra["tracking"] = TrackerCounts(len(self.tracker), self.tracker.dropped,
+                                                           self.tube_exits)
         return cmd

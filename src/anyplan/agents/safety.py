@@ -1,47 +1,15 @@
 """The safety invariant for agents that plan among moving obstacles, and its fallbacks.
 
-**The rule.** The robot only starts (switches to) a motion ``M`` at time ``t_s`` when either
-
-* ``M`` is predicted collision-free from ``t_s`` until it ends at rest ("free to rest"), or
-* ``M`` can still be abandoned: the *escape* "follow ``M`` until ``t_s + commit_s``, then brake to
-  rest at a_max and alpha_max" (:func:`anyplan.trajectory.motion.brake_to_rest`) is predicted
-  collision-free until the robot is at rest, and its braking path clears the static obstacles
-  ("stoppable"). ``commit_s`` is the time the agent needs before it can act again (its check
-  period plus its planning delay), so M's first predicted collision lies beyond the time the
-  robot needs to come to rest on M.
-
-Predictions use the certified predictor (:func:`anyplan.prediction.collision.first_collision`),
-with the robot's radius plus ``margin`` against each predicted disc (whatever the predictor
-gives). A contact that can only happen once the robot is at rest is not one the robot causes.
-
-**Fallbacks.** When the proposed motion breaks the rule (or there is none) and the current motion
-cannot be kept either (:meth:`SafetyGuard.still_safe`), the guard picks one of
-
-* ``brake``: brake to rest on the current path and stay (``hold`` when already at rest);
-* ``turn_away``: brake, turn in place and move ``d`` sideways, perpendicular to the threat;
-* ``back_off``: brake, turn in place and move ``d`` straight away from the threat,
-
-(``d`` in ``config.offsets_m``, keeping the static clearance) by **predicted clearance over a
-horizon**: the candidates whose moving part is predicted collision-free come first, and among them
-the one with the largest certified minimum distance to every predicted obstacle over
-``[t_s, t_s + horizon_s]`` (:func:`anyplan.geometry.moving.closest_approach`). "The motion whose
-collision is latest" is never chosen while a safe option exists.
-
-API (shared by ``seq-bitstar`` and any other agent)::
-
-    guard = SafetyGuard(spec, static_obstacles, SafetyConfig())    # once per run
-    # the planner proposes ``motion`` (a Trajectory, or None) that would start at t_switch from
-    # ``state`` (the robot's state then, on its current reference); ``current`` is what the
-    # robot executes now (None before the first plan):
-    d = guard.decide(t_switch, motion, current, state, predictions, commit_s)
-    # d.kind: "motion" (start it), "keep" (keep ``current``) or a fallback kind;
-    # execute d.trajectory from t_switch (d.trajectory is current when d.kind == "keep").
-    guard.still_safe(current, predictions, t, commit_s)    # periodic re-check of the current motion
-    result_extra["fallbacks"] = guard.fallbacks            # [{"t", "kind", "predicted_clearance_m"}]
-    guard.decisions                                        # every Decision, with its trajectory
-
-Every decision is logged (:attr:`SafetyGuard.decisions`) with what it was checked against, so a
-test can re-predict it independently; :meth:`SafetyGuard.log` is its JSON form.
+The robot only starts a motion M at t_s when M is predicted collision-free until it ends at rest
+("free to rest"), or when its *escape* (follow M until ``t_s + commit_s``, then brake to rest at
+a_max and alpha_max, :class:`Escape`) is predicted free until the robot stands and clears the
+static obstacles ("stoppable"); ``commit_s`` is the time the agent needs to act again. Otherwise
+:class:`SafetyGuard` keeps the current motion if it still passes, or takes the fallback
+(``brake``/``hold``, ``turn_away``, ``back_off``) with the largest certified predicted clearance
+over a horizon among those whose moving part is predicted free. Predictions:
+:func:`anyplan.prediction.collision.first_collision` with the robot radius plus ``margin``.
+Every decision is logged (:attr:`SafetyGuard.decisions`, JSON form :meth:`SafetyGuard.log`).
+Rule, API and tests: ``docs/sequential.md`` ("The safety invariant and its fallbacks").
 """
 
 from __future__ import annotations
@@ -58,35 +26,15 @@ from anyplan.geometry.moving import closest_approach
 from anyplan.prediction.base import PredictedObstacle
 from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.motion import brake_to_rest, polyline_trajectory
-from anyplan.trajectory.trajectory import BrakeSegment, Segment, Trajectory
+from anyplan.trajectory.reference import HoldSegment, come_to_rest, state_at
+from anyplan.trajectory.trajectory import BrakeSegment, Trajectory
 from anyplan.world.robot import RobotSpec, RobotState
 
-__all__ = ["SafetyConfig", "Decision", "Escape", "SafetyGuard", "HoldSegment", "escape_motion",
-           "FALLBACK_KINDS"]
+__all__ = ["SafetyConfig", "Decision", "Escape", "SafetyGuard", "escape_motion", "FALLBACK_KINDS"]
 
 #: The fallback kinds, in order of preference when their clearances tie.
 FALLBACK_KINDS = ("hold", "brake", "turn_away", "back_off")
 _EPS_V = 1e-6  # [m/s] below this the robot counts as at rest
-
-
-class HoldSegment(Segment):
-    """Standing still at (x, y, theta) from ``t0`` to ``t1`` [s]."""
-
-    kind = "hold"
-
-    def __init__(self, x: float, y: float, theta: float, t0: float, t1: float) -> None:
-        self.x, self.y, self.theta = float(x), float(y), float(theta)
-        self.t0, self.t1 = float(t0), float(t1)
-        self.max_speed = 0.0
-        self.length = 0.0
-
-    def sample(self, t: np.ndarray) -> tuple[np.ndarray, ...]:  # type: ignore[override]
-        t = np.asarray(t, dtype=float)
-        z = np.zeros(t.shape)
-        return np.full(t.shape, self.x), np.full(t.shape, self.y), np.full(t.shape, self.theta), z, z
-
-    def path_points(self, step: float) -> np.ndarray:
-        return np.array([[self.x, self.y]])
 
 
 @dataclass(frozen=True)
@@ -131,7 +79,7 @@ class Escape:
                  radius: float) -> None:
         self.motion = motion
         self.t_commit = float(min(max(t_commit, motion.t_start), motion.t_end))
-        st = motion.state(self.t_commit)
+        st = state_at(motion, self.t_commit)
         segs, t_rest, _, free = brake_to_rest(st, spec, obstacles, radius, self.t_commit)
         self.brake: BrakeSegment | None = segs[0] if segs else None  # type: ignore[assignment]
         self.t_rest = float(t_rest)
@@ -316,15 +264,8 @@ class SafetyGuard:
         static clearance."""
         spec, cfg = self.spec, self.config
         h = t + cfg.horizon_s
-        segs, t_rest, rest, _ = brake_to_rest(state, spec, self.obstacles, spec.radius, t)
+        segs, t_rest, rest, _ = come_to_rest(state, spec, self.obstacles, spec.radius, t)
         moving = abs(state.v) > _EPS_V
-        if abs(rest.omega) > 1e-9:
-            stop = BrakeSegment(rest.x, rest.y, rest.theta, 0.0, rest.omega, spec.a_max,
-                                spec.alpha_max, t_rest)
-            segs.append(stop)
-            t_rest = stop.t1
-            x, y, th, _, _ = stop.sample(np.array([t_rest]))
-            rest = RobotState(float(x[0]), float(y[0]), float(th[0]), 0.0, 0.0)
         hold = Trajectory(segs + [HoldSegment(rest.x, rest.y, rest.theta, t_rest, max(h, t_rest))],
                           kind="brake" if moving else "hold")
         out: list[tuple[str, Trajectory, float]] = [("brake" if moving else "hold", hold, t_rest)]

@@ -2,63 +2,40 @@
 
 At the start, and whenever a collision with a moving obstacle is predicted on the current
 reference motion, the agent runs :class:`~anyplan.planning.sequential.SequentialBITStar` (the
-paper's Algorithm 1 with our extensions) and takes up the new motion with Kanayama's tracking law.
-
-Planning takes time, and that time passes in the simulation too: a replanning that starts at
-time t plans from the state the robot will have at ``t + d`` on its current reference, where
-``d`` is the expected planning time rounded up to the control period, and the robot keeps
-following its current reference until then. With ``planning_delay="measured"`` (the default)
-``d`` is predicted from the previous planning times and checked against the wall-clock time of
-the actual computation: when the computation took longer, the switch waits for it (the new
-reference then starts slightly behind the robot's pose; Kanayama's law absorbs the offset). A
-fixed ``planning_delay`` in seconds makes runs reproducible for a seed, independent of the
-machine.
-
-**The safety invariant** (:mod:`anyplan.agents.safety`) wraps what the agent executes: a new
-motion is only taken up when it is predicted collision-free until it ends at rest, or when the
-robot can still brake to rest on it without a predicted collision after the time it needs to act
-again (check period + planning delay). Otherwise the agent keeps its current motion if that one
-still passes, or takes the fallback (brake, hold, turn away, back off) with the largest predicted
-clearance; fallbacks are listed in ``stats.extra["fallbacks"]`` and every decision in
-``stats.extra["safety"]``. Algorithm 1 itself is unchanged; ``safety=False`` turns the
-invariant off (the paper's behaviour: a motion with a predicted collision is taken when no
-collision-free one is found).
-
-Moving obstacles are known through observations only; their motion is predicted with a constant
-twist (:class:`~anyplan.prediction.ConstantTwistPredictor`), which is exact for the paper's
-obstacles. With ``robot.sensing_range`` set, obstacles appear when they come into range and the
-next check replans around them.
+paper's Algorithm 1 with our extensions) with a :class:`~anyplan.trajectory.reference.Departure`
+(the reference motions from the state the robot will have when the new motion starts) and
+takes up the new motion with Kanayama's tracking law. The online timing policy (planning delay,
+late plans, back-off) is :class:`~anyplan.agents.replanning.ReplanningAgent`'s; the safety
+invariant (:mod:`anyplan.agents.safety`) decides what is executed (``safety=False``: the paper's
+behaviour). Moving obstacles are predicted with a constant twist
+(:class:`~anyplan.prediction.ConstantTwistPredictor`). Statistics:
+:class:`~anyplan.agents.stats.SequentialStats`. See ``docs/sequential.md``.
 """
 
 from __future__ import annotations
 
-import math
 import time
 from typing import Any
 
 import numpy as np
 
-from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
-from anyplan.agents.safety import HoldSegment, SafetyConfig, SafetyGuard
+from anyplan.agents.base import Observation
+from anyplan.agents.replanning import MAX_BACKOFF_S, ReplanningAgent
+from anyplan.agents.safety import SafetyConfig, SafetyGuard
+from anyplan.agents.stats import SequentialStats
 from anyplan.agents.warmup import warm_up_kernels
-from anyplan.control.kanayama import KanayamaController, KanayamaGains
-from anyplan.geometry.shapes import Shape
+from anyplan.control.kanayama import KanayamaGains
 from anyplan.planning.sequential import SequentialBITStar, SequentialConfig, SequentialResult
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
 from anyplan.prediction.collision import first_collision
-from anyplan.trajectory.motion import brake_to_rest, continue_from, plan_motion
-from anyplan.trajectory.trajectory import BrakeSegment, Trajectory
-from anyplan.world.robot import Command, RobotState
+from anyplan.trajectory.reference import ReferenceBuilder
+from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.scenario import Scenario
 
-__all__ = ["SequentialBITStarAgent", "HoldSegment"]
+__all__ = ["SequentialBITStarAgent", "MAX_BACKOFF_S"]
 
 
-#: Longest wait [s] between two replannings after repeated failures.
-MAX_BACKOFF_S = 2.0
-
-
-class SequentialBITStarAgent(Agent):
+class SequentialBITStarAgent(ReplanningAgent):
     """Sequential BIT* with online replanning.
 
     Args:
@@ -85,7 +62,7 @@ class SequentialBITStarAgent(Agent):
     #: wall-clock cap far above any planning time: the run no longer depends on the machine.
     deterministic_settings = {"planning_delay": 0.1, "batches_per_plan": 2,  # noqa: RUF012
                               "max_time_s": 10.0}
-    wall_clock_extra = ("plan_time_s", "motion_time_s", "progress", "late_plans", "safety_time_s")
+    wall_clock_extra = SequentialStats.WALL_CLOCK
 
     def __init__(self, config: SequentialConfig | None = None, *, plan_margin: float = 0.03,
                  smooth_margin: float = 0.015, check_period_s: float = 0.2,
@@ -93,27 +70,20 @@ class SequentialBITStarAgent(Agent):
                  planning_delay: str | float = "measured", grid_step: float = 0.05,
                  gains: KanayamaGains | None = None, safety: bool = True,
                  safety_config: SafetyConfig | None = None, **loop_options: Any) -> None:
-        super().__init__()
         if config is None:
             config = SequentialConfig(**loop_options)
         elif loop_options:
             raise ValueError("give either config or loop options, not both")
         if not 0.0 <= smooth_margin <= plan_margin:
             raise ValueError("smooth_margin: must be in [0, plan_margin]")
-        if not check_period_s > 0.0:
-            raise ValueError(f"check_period_s: must be > 0, got {check_period_s}")
-        if planning_delay != "measured" and not (isinstance(planning_delay, int | float)
-                                                 and planning_delay >= 0.0):
-            raise ValueError(f"planning_delay: 'measured' or a delay >= 0 s, got {planning_delay!r}")
+        super().__init__(check_period_s=check_period_s,
+                         min_replan_interval_s=min_replan_interval_s, urgent_s=urgent_s,
+                         planning_delay=planning_delay, max_delay_s=config.max_time_s,
+                         gains=gains)
         self.config = config
         self.plan_margin = float(plan_margin)
         self.smooth_margin = float(smooth_margin)
-        self.check_period_s = float(check_period_s)
-        self.min_replan_interval_s = float(min_replan_interval_s)
-        self.urgent_s = float(urgent_s)
-        self.planning_delay = planning_delay
         self.grid_step = float(grid_step)
-        self.gains = gains or KanayamaGains()
         self.safety = bool(safety)
         self.safety_config = safety_config or SafetyConfig(margin=config.margin,
                                                            recheck_margin=0.5 * config.margin)
@@ -121,110 +91,42 @@ class SequentialBITStarAgent(Agent):
     # --- lifecycle -------------------------------------------------------------------------------
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
         warm_up_kernels(self.kernel_parts)  # compile or load now, not inside a timed replanning
-        self.stats = AgentStats()
         self.spec = scenario.robot
         self.obstacles = scenario.obstacle_set()
         self.rng = rng
         self.predictor = ConstantTwistPredictor()
-        self.loop = SequentialBITStar(self.obstacles, self.spec.radius,
-                                      self.spec.radius + self.plan_margin, None, self.config, rng)
-        self.controller = KanayamaController(self.spec, self.gains, 0.05)
-        self.trajectory: Trajectory | None = None
-        self.pending: tuple[float, Trajectory] | None = None
-        self._dt: float | None = None
-        self._last_t: float | None = None
-        self._last_check = -math.inf
-        self._last_replan = -math.inf
-        self._failures = 0  # consecutive replannings without a motion
-        self._retry_at = -math.inf  # no replanning before this time [s] (back-off)
-        self._seen: set[str] = set()
-        self._requested: str | None = None
-        self.tracking = TrackingLog()
+        self.loop = SequentialBITStar(self.obstacles, robot_radius=self.spec.radius,
+                                      plan_radius=self.spec.radius + self.plan_margin,
+                                      config=self.config, rng=rng)
+        self.reference = ReferenceBuilder(spec=self.spec, obstacles=self.obstacles,
+                                          smooth_margin=self.smooth_margin,
+                                          grid_step=self.grid_step)
         self.guard = SafetyGuard(self.spec, self.obstacles, self.safety_config)
-        self.executed: list[tuple[float, Trajectory]] = []  # (switch time [s], trajectory)
+        self._reset_timing(self._new_record())
         self._fallback_active = False
         self._commit_s = self.check_period_s + 0.1
-        ex = self.stats.extra
-        ex.update({"statuses": {}, "iterations": [], "late_plans": 0, "plan_time_s": [],
-                   "motion_time_s": [], "replan_times_s": [], "waits": 0,
-                   "fallbacks": self.guard.fallbacks, "safety_time_s": []})
 
-    # --- motions ---------------------------------------------------------------------------------
-    def _motion_fn(self, state: RobotState, t_start: float):  # noqa: ANN202
-        spec = self.spec
-        margin = min(self.smooth_margin,
-                     max(self.obstacles.clearance((state.x, state.y)) - spec.radius, 0.0))
-
-        def build(path: np.ndarray, shapes: list[Shape], delay: float) -> Trajectory:
-            obst = self.obstacles.with_shapes(shapes) if shapes else self.obstacles
-            if delay <= 0.0:
-                return plan_motion(path, spec, state, obst, t_start, margin=margin, grid_step=self.grid_step)
-            segs, t, rest, _ = brake_to_rest(state, spec, obst, spec.radius + margin, t_start)
-            if abs(rest.omega) > 1e-9:  # turning in place: stop the rotation at alpha_max too
-                stop = BrakeSegment(rest.x, rest.y, rest.theta, 0.0, rest.omega, spec.a_max,
-                                    spec.alpha_max, t)
-                segs.append(stop)
-                t = stop.t1
-                rest = RobotState(*(float(v[0]) for v in stop.sample(np.array([t]))))
-            segs.append(HoldSegment(rest.x, rest.y, rest.theta, t, t + delay))
-            rest = RobotState(rest.x, rest.y, rest.theta, 0.0, 0.0)
-            p = continue_from(np.array([rest.x, rest.y]), np.asarray(path, dtype=float), obst,
-                              spec.radius + margin)
-            tail = plan_motion(p, spec, rest, obst, t + delay, margin=margin, grid_step=self.grid_step)
-            return Trajectory(segs + tail.segments, kind="wait+" + tail.kind, feasible=tail.feasible,
-                              lower_bound_s=tail.lower_bound_s, polyline=tail.polyline,
-                              info=tail.info, certified_free=tail.certified_free)
-
-        return build
+    def _new_record(self) -> SequentialStats:
+        return SequentialStats(fallbacks=self.guard.fallbacks)
 
     # --- planning --------------------------------------------------------------------------------
-    def _expected_delay(self, dt: float) -> float:
-        if self.planning_delay != "measured":
-            d = float(self.planning_delay)
-        else:
-            # 1.5 x the longest of the last five replannings, within [0.1 s, max_time_s]: an
-            # outlier must not park the robot on a stale reference for long; a replanning that
-            # takes longer than expected is re-timed when it ends (see _replan).
-            recent = self.stats.planning_times_s[-5:]
-            d = min(max(1.5 * max(recent), 0.1), self.config.max_time_s) if recent else 0.1
-        return max(dt, math.ceil(d / dt - 1e-9) * dt)
-
-    def _state_at(self, obs: Observation, t: float) -> RobotState:
-        """The state the robot will have at time ``t`` [s]: on its reference, or at rest."""
-        if self.trajectory is None:
-            r = obs.robot
-            return RobotState(r.x, r.y, r.theta, 0.0, 0.0)
-        return self.trajectory.state(t)
-
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
-        dt = self._dt or 0.05
+        dt, d, t_ready, state = self._begin_replan(obs)
         t = obs.t
-        d = self._expected_delay(dt)
-        t_ready = t + d
-        state = self._state_at(obs, t_ready)
         w0 = time.perf_counter()
         res: SequentialResult = self.loop.replan(np.array([state.x, state.y]),
                                                  np.asarray(self.spec.goal, dtype=float), preds, t,
-                                                 self._motion_fn(state, t_ready))
+                                                 self.reference.departing(state, t_ready))
         wall = time.perf_counter() - w0
-        self._last_replan = t
-        st = self.stats
-        st.planning_times_s.append(wall)
-        if self.trajectory is not None or len(st.planning_times_s) > 1:
-            st.replans += 1
-        ex = st.extra
-        ex["statuses"][res.status] = ex["statuses"].get(res.status, 0) + 1
-        ex["iterations"].append(res.iterations)
-        ex["plan_time_s"].append(res.plan_time_s)
-        ex["motion_time_s"].append(res.motion_time_s)
-        ex["replan_times_s"].append(t)
-        ex.setdefault("reasons", []).append(reason)
+        self._record_replan(t, wall, res, reason)
+        rec = self.record
+        rec.plan_time_s.append(res.plan_time_s)
+        rec.motion_time_s.append(res.motion_time_s)
         if res.status == "waiting":
-            ex["waits"] += 1
-        st.virtual_obstacles.extend(v.to_dict() for v in res.virtual_obstacles)
-        if "progress" not in ex and res.history:
+            rec.waits += 1
+        if rec.progress is None and res.history:
             # BIT*'s cost against solve time in the first planning (OMPL's progress property).
-            ex["progress"] = [[float(a), float(b)] for a, b in res.history]
+            rec.progress = [[float(a), float(b)] for a, b in res.history]
         if res.motion is None:
             if self.safety:
                 self._guarded(obs, None, t_ready, d, preds, res)
@@ -237,18 +139,18 @@ class SequentialBITStarAgent(Agent):
         self._failures = 0
         motion: Trajectory = res.motion  # type: ignore[assignment]
         t_switch = t_ready
-        if self.planning_delay == "measured" and wall > d + 1e-9:
+        late = self._late_switch(t, wall, d, dt)
+        if late is not None:
             # Late: the computation outlasted the expected delay. The robot went on with its
             # current reference (or stayed at rest) meanwhile, so the new motion is re-timed
             # from the state it will have when the new plan is really ready. The re-timing
             # time counts as planning time too.
             w1 = time.perf_counter()
-            ex["late_plans"] += 1
-            t_switch = t + math.ceil(wall / dt - 1e-9) * dt
+            t_switch = late
             state = self._state_at(obs, t_switch)
             shapes = [v.shape for v in res.virtual_obstacles]
-            motion = self._motion_fn(state, t_switch)(res.path, shapes, res.delay_s)
-            st.planning_times_s[-1] = wall + (time.perf_counter() - w1)
+            motion = self.reference.departing(state, t_switch)(res.path, shapes, res.delay_s)
+            self.stats.planning_times_s[-1] = wall + (time.perf_counter() - w1)
         if self.safety:
             self._guarded(obs, motion, t_switch, t_switch - t, preds, res)
             return
@@ -271,9 +173,8 @@ class SequentialBITStarAgent(Agent):
         dec = self.guard.decide(t_switch, motion, current, state, preds, self._commit_s)
         wall = time.perf_counter() - w0
         self.stats.planning_times_s[-1] += wall  # the decision is part of the planning call
-        ex = self.stats.extra
-        ex["safety_time_s"].append(wall)
-        ex["safety"] = self.guard.log()
+        self.record.safety_time_s.append(wall)
+        self.record.safety = self.guard.log()
         if dec.kind == "keep":
             return
         if dec.kind == "motion":
@@ -281,62 +182,18 @@ class SequentialBITStarAgent(Agent):
         self._fallback_active = dec.kind not in ("motion", "keep")
         self.pending = (t_switch, dec.trajectory)
 
-    # --- control ---------------------------------------------------------------------------------
-    def act(self, obs: Observation) -> Command:
-        if self._last_t is not None and obs.t > self._last_t:
-            self._dt = obs.t - self._last_t
-            self.controller.dt = self._dt
-        self._last_t = obs.t
-        t = obs.t
-        preds = self.predictor.predict(obs.obstacles)
-        if self.pending is not None and t >= self.pending[0] - 1e-9:
-            self._switch()
-        if self.trajectory is None and self.pending is None:
-            # The first plan: the robot stays at rest while it is computed.
-            if t < self._retry_at - 1e-9:
-                return Command(0.0, 0.0)
-            self._replan(obs, preds, "initial")
-            self._last_check = t
-            self._seen = {p.name for p in preds}
-            if self.pending is not None and t >= self.pending[0] - 1e-9:
-                self._switch()
-        elif (self.trajectory is not None and self.pending is None
-              and (t - self._last_check >= self.check_period_s - 1e-9
-                   or self._requested is not None)):
-            self._check(obs, preds)
-        traj = self.trajectory
-        if traj is None:
-            return Command(0.0, 0.0)
-        ref = traj.state(t)
-        self.tracking.add((ref.x, ref.y), obs.robot, self.stats.extra)
-        return self.controller.command(traj, obs.robot, t)
-
-    def request_replan(self, reason: str) -> None:
-        """Replan at the next step (e.g. an obstacle left its predicted tube)."""
-        self._requested = reason
-
-    def _switch(self) -> None:
-        assert self.pending is not None
-        self.trajectory = self.pending[1]
-        self.executed.append(self.pending)
-        self.pending = None
-
+    # --- checks ----------------------------------------------------------------------------------
     def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
         t = obs.t
         if self._requested is not None:
             reason, self._requested = self._requested, None
-            self._last_check = t
-            self._seen |= {p.name for p in preds}
+            self._observe_check(obs, preds)
             self._replan(obs, preds, reason)
             return
-        self._last_check = t
+        new = self._observe_check(obs, preds)
         traj = self.trajectory
         assert traj is not None
-        names = {p.name for p in preds}
-        new = names - self._seen
-        self._seen |= names
-        if t >= traj.t_end and math.hypot(obs.robot.x - self.spec.goal[0],
-                                          obs.robot.y - self.spec.goal[1]) <= self.spec.goal_tolerance:
+        if self._arrived(obs, traj):
             return
         if self.safety and self._fallback_active:
             # Parked by a fallback: try again to get going.

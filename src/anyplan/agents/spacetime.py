@@ -1,45 +1,33 @@
 """The ``st-bitstar`` agent: BIT* paths timed in space-time among the predicted moving obstacles.
 
-Path-velocity decomposition (see ``docs/spacetime.md``):
-
-1. At a replanning, the path in use is tried first, from the robot's new state (steps 2 and 4,
-   no search when its timing is within ``accept_s`` of its untimed arrival; a slower timing
-   stays a candidate). Otherwise BIT* plans a path among the static obstacles; :func:`~anyplan.trajectory.plan_motion` smooths
-   it into a reference motion within v, omega, a and alpha.
-2. The curve is **re-timed** (:func:`anyplan.trajectory.spacetime.retime`): the earliest
-   acceleration-bounded motion along it that avoids the s-t regions of the predicted discs, so
-   the robot may slow down, wait and pass behind an obstacle.
-3. Unless the timing arrives within ``accept_s`` of the path's own (untimed) arrival, a virtual
-   square is put where the untimed motion meets the obstacle, as Sequential BIT* does, and the
-   detour BIT* then finds is timed the same way (up to ``config.max_iterations`` paths, each
-   timed with waits up to ``patience_s``); the earliest arrival among the timed candidates
-   wins. If none can be timed, the shortest and the last path are timed
-   again allowing waits up to ``max_wait_s``, and the earlier arrival wins.
-4. Every motion is verified with the certified continuous check
-   (:func:`anyplan.trajectory.spacetime.verify`) before it is executed. When no candidate is
-   verified free, the robot does not start one: it brakes to rest on its current reference and
-   holds (a *fallback*, recorded in ``extra.fallbacks``).
-
-The replanning loop, planning delay and tracking are those of the ``seq-bitstar`` agent
-(:class:`~anyplan.agents.sequential.SequentialBITStarAgent`); replanning happens when the
-current motion is predicted to collide (the check runs every ``check_period_s``).
+Path-velocity decomposition: the path in use is tried first from the robot's new state;
+otherwise the Sequential BIT* loop supplies candidate paths (detours around virtual squares),
+each smoothed into a reference motion (:class:`~anyplan.trajectory.reference.Departure`) and
+**re-timed** (:func:`anyplan.trajectory.spacetime.retime`: the earliest acceleration-bounded
+motion along it that avoids the s-t regions of the predicted discs, waits included). A timing
+within ``accept_s`` of the untimed arrival ends the search; otherwise the earliest timed arrival
+wins. Every motion is verified (:func:`anyplan.trajectory.spacetime.verify`) before it is
+executed; when none is, the robot brakes to rest and holds (``extra.fallbacks``). The online
+timing policy is :class:`~anyplan.agents.replanning.ReplanningAgent`'s, shared with
+``seq-bitstar``. Statistics: :class:`~anyplan.agents.stats.SpaceTimeStats`. See
+``docs/spacetime.md``.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
 from anyplan.agents.base import Observation
-from anyplan.agents.sequential import HoldSegment, SequentialBITStarAgent
+from anyplan.agents.sequential import SequentialBITStarAgent
+from anyplan.agents.stats import SpaceTimeStats
 from anyplan.geometry.shapes import Shape
-from anyplan.planning.sequential import SequentialConfig, SequentialResult
+from anyplan.planning.sequential import MotionModel, SequentialConfig, SequentialResult
 from anyplan.prediction.base import PredictedObstacle
-from anyplan.trajectory.motion import brake_to_rest
 from anyplan.trajectory.spacetime import retime, verify
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import RobotState
@@ -107,6 +95,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
 
     name = "st-bitstar"
     config_classes = (_DEFAULT_LOOP,)  # its defaults, for the listing of settings
+    record: SpaceTimeStats
 
     def __init__(self, config: SequentialConfig | None = None, *, patience_s: float = 3.0,
                  max_wait_s: float = 30.0, lattice_dt_s: float = 0.25, accept_s: float = 0.5,
@@ -136,15 +125,18 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         self._path: np.ndarray | None = None
         self._shapes: list[Shape] = []
         self._preds: list[PredictedObstacle] = []
-        ex = self.stats.extra
-        ex.update({"fallbacks": [], "st_waits_s": [], "st_timed": 0, "st_candidates": []})
+
+    def _new_record(self) -> SpaceTimeStats:
+        return SpaceTimeStats()
 
     # --- motions ---------------------------------------------------------------------------------
-    def _timed_fn(self, state: RobotState, t_start: float, max_wait_s: float):  # noqa: ANN202
-        nominal_fn = self._motion_fn(state, t_start)
+    def _timed_fn(self, state: RobotState, t_start: float, max_wait_s: float) -> MotionModel:
+        """The motion model of the loop: each motion re-timed, the timed ones kept as
+        candidates (``self._cands``)."""
+        nominal_fn = self.reference.departing(state, t_start)
         spec, cfg = self.spec, self.config
 
-        def build(path: np.ndarray, shapes: list[Shape], delay: float) -> Trajectory:
+        def build(path: np.ndarray, shapes: Sequence[Shape], delay: float) -> Trajectory:
             if delay == 0.0:
                 self._tried.append((np.asarray(path), list(shapes)))
             nominal = nominal_fn(path, shapes, delay)
@@ -188,23 +180,18 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                   reason: str) -> Trajectory:
         """Brake to rest on the current reference (or stay) and hold."""
         state = self._state_at(obs, t_switch)
-        segs, t_rest, rest, _ = brake_to_rest(state, self.spec, self.obstacles, self.spec.radius,
-                                              t_switch)
-        segs.append(HoldSegment(rest.x, rest.y, rest.theta, t_rest, t_rest + 1e4))
-        tr = Trajectory(segs, kind="fallback-hold", lower_bound_s=0.0)
+        tr, t_rest = self.reference.hold(state, t_switch, 1e4, kind="fallback-hold",
+                                         stop_rotation=False)
         hit = verify(tr, preds, self.spec.radius, t_until=t_rest + 10.0) if preds else None
-        self.stats.extra["fallbacks"].append(
+        self.record.fallbacks.append(
             {"t": float(obs.t), "kind": "brake-hold", "reason": reason,
              "predicted_collision_s": None if hit is None else float(hit.t)})
         return tr
 
     # --- planning --------------------------------------------------------------------------------
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
-        dt = self._dt or 0.05
+        dt, d, t_ready, state = self._begin_replan(obs)
         t = obs.t
-        d = self._expected_delay(dt)
-        t_ready = t + d
-        state = self._state_at(obs, t_ready)
         self._cands = []
         self._tried = []
         self._preds = list(preds)
@@ -237,25 +224,15 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         elif res.collision_free and res.motion is not None:
             motion = res.motion  # type: ignore[assignment]
         wall = time.perf_counter() - w0
-        self._last_replan = t
-        st = self.stats
-        st.planning_times_s.append(wall)
-        if self.trajectory is not None or len(st.planning_times_s) > 1:
-            st.replans += 1
-        ex = st.extra
-        ex["statuses"][res.status] = ex["statuses"].get(res.status, 0) + 1
-        ex["iterations"].append(res.iterations)
-        ex["replan_times_s"].append(t)
-        ex.setdefault("reasons", []).append(reason)
-        ex["st_candidates"].append(len(self._cands))
-        st.virtual_obstacles.extend(v.to_dict() for v in res.virtual_obstacles)
+        self._record_replan(t, wall, res, reason)
+        self.record.st_candidates.append(len(self._cands))
         t_switch = t_ready
-        if self.planning_delay == "measured" and wall > d + 1e-9:
+        late = self._late_switch(t, wall, d, dt)
+        if late is not None:
             # Late: the computed motion starts in the past. Re-time from the state the robot
             # will really have, on the same path (no new search).
             w1 = time.perf_counter()
-            ex["late_plans"] += 1
-            t_switch = t + math.ceil(wall / dt - 1e-9) * dt
+            t_switch = late
             state = self._state_at(obs, t_switch)
             motion = None
             if len(path):
@@ -263,7 +240,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 self._timed_fn(state, t_switch, self.max_wait_s)(np.asarray(path), shapes, 0.0)
                 if self._cands:
                     motion = self._cands[0][1]
-            st.planning_times_s[-1] = wall + (time.perf_counter() - w1)
+            self.stats.planning_times_s[-1] = wall + (time.perf_counter() - w1)
         if motion is None:
             if self.trajectory is not None and verify(
                     self.trajectory, preds, self.spec.radius, t_from=t_switch,
@@ -272,25 +249,21 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             motion = self._fallback(obs, t_switch, preds, res.status)
         else:
             self._path, self._shapes = np.asarray(path), list(shapes)
-            ex["st_timed"] += int(motion.kind.startswith("st+"))
-            ex["st_waits_s"].append(float(motion.info.get("wait_s", 0.0)))
-        st.plans.append({"t": t, "t_start": t_switch, "path": np.asarray(path).tolist(),
-                         "status": res.status, "kind": motion.kind,
-                         "virtual_obstacles": len(res.virtual_obstacles),
-                         "arrival_s": float(motion.t_end)})
+            self.record.st_timed += int(motion.kind.startswith("st+"))
+            self.record.st_waits_s.append(float(motion.info.get("wait_s", 0.0)))
+        self.stats.plans.append({"t": t, "t_start": t_switch, "path": np.asarray(path).tolist(),
+                                 "status": res.status, "kind": motion.kind,
+                                 "virtual_obstacles": len(res.virtual_obstacles),
+                                 "arrival_s": float(motion.t_end)})
         self.pending = (t_switch, motion)
 
     def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
         t = obs.t
-        self._last_check = t
+        new = self._observe_check(obs, preds)
         traj = self.trajectory
         assert traj is not None
-        names = {p.name for p in preds}
-        new = names - self._seen
-        self._seen |= names
         spec = self.spec
-        if t >= traj.t_end and math.hypot(obs.robot.x - spec.goal[0],
-                                          obs.robot.y - spec.goal[1]) <= spec.goal_tolerance:
+        if self._arrived(obs, traj):
             return
         if traj.kind == "fallback-hold" and t - self._last_replan >= self.min_replan_interval_s:
             self._replan(obs, preds, "holding")

@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import logging
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -106,6 +107,10 @@ def _sequential() -> None:
     from anyplan.world.motion import UnicycleMotion
     from anyplan.world.robot import RobotState
 
+    if TYPE_CHECKING:
+        from anyplan.geometry.shapes import Shape
+        from anyplan.trajectory.trajectory import Trajectory
+
     obs, spec = _scene()
     path = np.array([[0.5, 0.5], [3.0, 1.2], [3.5, 3.5]])
     traj = plan_motion(path, spec, RobotState(0.5, 0.5, 0.3, 0.2, 0.1), obs, 0.0)
@@ -116,12 +121,13 @@ def _sequential() -> None:
     crossing = PredictedObstacle("X", 0.2, UnicycleMotion(2.0, 0.2, 1.5708, 0.25, 0.0))
     rest = RobotState(0.5, 3.0, -0.7854)
 
-    def motion_fn(p: np.ndarray, shapes: list, delay: float):  # noqa: ANN202
+    def motion_fn(p: np.ndarray, shapes: Sequence[Shape], delay: float) -> Trajectory:
         return plan_motion(p, spec, rest, obs.with_shapes(shapes), delay, margin=0.015, grid_step=0.05)
 
-    loop = SequentialBITStar(obs, spec.radius, spec.radius + 0.03, motion_fn,
-                             SequentialConfig(max_iterations=3, wait_delays_s=(1.0,)),
-                             np.random.default_rng(0))
+    loop = SequentialBITStar(obs, robot_radius=spec.radius, plan_radius=spec.radius + 0.03,
+                             motion=motion_fn,
+                             config=SequentialConfig(max_iterations=3, wait_delays_s=(1.0,)),
+                             rng=np.random.default_rng(0))
     loop.replan(np.array([0.5, 3.0]), np.array([3.5, 0.5]), [crossing], 0.0)
 
 

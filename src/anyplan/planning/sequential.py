@@ -1,33 +1,13 @@
 """Sequential BIT*: plan among static obstacles, then add virtual obstacles where moving ones hit.
 
 Roy, Harchowdhury & Vachhani, "Anytime Planning: A Motion Planner for Dynamic Environment"
-(Algorithm 1). Given the robot's state, the static world and the predicted motions of the moving
-obstacles:
-
-1. plan a shortest path with BIT* (:class:`~anyplan.planning.bitstar.BITStar`);
-2. turn it into a timed reference motion (smoothing and velocity profile; injected here as
-   ``motion_fn`` so that this module stays below the trajectory layer);
-3. predict, continuously in time, the first collision with any moving obstacle
-   (:func:`anyplan.prediction.collision.first_collision`);
-4. if there is one, add a *virtual static obstacle* there: an axis-aligned square of side
-   ``2 (r_robot + r_obstacle)`` centred at the robot's reference position at the predicted
-   collision, and plan again (step 1);
-5. otherwise return the collision-free path, its motion and the virtual obstacles.
-
-What we do beyond the paper (each documented in ``docs/sequential.md``):
-
-* **Continued search, measured.** With ``warm_start`` BIT* continues from its current graph
-  after a square is added (:meth:`BITStar.add_obstacles` invalidates only what the square
-  blocks) instead of starting over. ``benchmarks/replan.py`` measures both in the same run;
-  with the small per-iteration budgets that replanning needs, a fresh search per iteration was
-  faster (the continued search re-expands the whole surviving graph of the first plan), so it
-  is the default.
-* **Squares at the start or the goal are shrunk** (kept centred, side reduced) until the robot
-  fits at the start and at the goal; a square that would have to shrink below ``min_side`` is
-  not added and that attempt counts as blocked.
-* **Waiting.** When the loop cannot find a collision-free motion within ``max_iterations`` (or
-  is blocked), the robot may wait: the paths found are tried again with the departure delayed
-  by each of ``wait_delays_s``. This keeps the robot safe where no detour exists in time.
+(Algorithm 1): plan a shortest path with BIT* (:class:`~anyplan.planning.bitstar.BITStar`), turn
+it into a timed reference motion (a :class:`MotionModel` that the caller passes in, e.g.
+:class:`anyplan.trajectory.reference.Departure`: this module stays below the trajectory layer),
+predict the first collision with a moving obstacle
+(:func:`anyplan.prediction.collision.first_collision`), put a virtual square of side
+2 (r + r_o) at the robot's reference position then, and plan again until the motion is free.
+Our extensions (continued search, shrunk squares, waiting): ``docs/sequential.md``.
 
 Notation: r robot radius [m], r_o obstacle radius [m], c collision point [m], s square side [m].
 """
@@ -36,9 +16,9 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -52,11 +32,19 @@ from anyplan.prediction.base import PredictedObstacle
 from anyplan.prediction.collision import PredictedCollision, TimedMotion, first_collision
 
 __all__ = ["SequentialConfig", "VirtualObstacle", "SequentialResult", "SequentialBITStar",
-           "shrink_square"]
+           "MotionModel", "shrink_square"]
 
-#: ``motion_fn(path, extra_shapes, delay_s)``: the timed reference motion along ``path`` (N, 2)
-#: among the static obstacles plus ``extra_shapes``, departing ``delay_s`` seconds late.
-MotionFn = Callable[[np.ndarray, Sequence[Shape], float], TimedMotion]
+
+class MotionModel(Protocol):
+    """What the loop needs from the trajectory layer: timed motions from one start state.
+
+    ``model(path, extra_shapes, delay_s)`` is the timed reference motion along ``path`` (N, 2)
+    [m] among the static obstacles plus ``extra_shapes`` (the virtual squares so far),
+    departing ``delay_s`` [s] late. :class:`anyplan.trajectory.reference.Departure` is one.
+    """
+
+    def __call__(self, path: np.ndarray, extra_shapes: Sequence[Shape], delay_s: float,
+                 /) -> TimedMotion: ...
 
 
 @dataclass(frozen=True)
@@ -224,20 +212,20 @@ class SequentialBITStar:
         obstacles: Static obstacles with the arena walls.
         robot_radius: [m].
         plan_radius: Radius [m] BIT* plans for (robot radius plus a planning margin).
-        motion_fn: Builds the timed motion along a path (see :data:`MotionFn`); may instead be
+        motion: Builds the timed motion along a path (a :class:`MotionModel`); may instead be
             given to each :meth:`replan` (it usually depends on the state the motion starts
             from).
         config: Loop settings.
         rng: Random generator of BIT*.
     """
 
-    def __init__(self, obstacles: ObstacleSet, robot_radius: float, plan_radius: float,
-                 motion_fn: MotionFn | None = None, config: SequentialConfig | None = None,
+    def __init__(self, obstacles: ObstacleSet, *, robot_radius: float, plan_radius: float,
+                 motion: MotionModel | None = None, config: SequentialConfig | None = None,
                  rng: np.random.Generator | None = None) -> None:
         self.obstacles = obstacles
         self.robot_radius = float(robot_radius)
         self.plan_radius = float(plan_radius)
-        self.motion_fn = motion_fn
+        self.motion = motion
         self.config = config or SequentialConfig()
         self.rng = rng if rng is not None else np.random.default_rng()
 
@@ -251,7 +239,7 @@ class SequentialBITStar:
         return any_of(timed(budget) & first_solution(), timed(20.0 * budget))
 
     def replan(self, start: np.ndarray, goal: np.ndarray, predictions: Sequence[PredictedObstacle],
-               t_now: float, motion_fn: MotionFn | None = None) -> SequentialResult:
+               t_now: float, motion: MotionModel | None = None) -> SequentialResult:
         """Plan from ``start`` to ``goal`` until the predicted motion is collision-free.
 
         Args:
@@ -259,11 +247,11 @@ class SequentialBITStar:
             goal: Goal (x, y) [m].
             predictions: Predicted moving obstacles (absolute times).
             t_now: Time [s] stamped on the virtual obstacles created.
-            motion_fn: The motion model for this replanning (default: the constructor's).
+            motion: The motion model for this replanning (default: the constructor's).
         """
-        motion_fn = motion_fn or self.motion_fn
+        motion_fn = motion or self.motion
         if motion_fn is None:
-            raise ValueError("motion_fn: give one to the constructor or to replan")
+            raise ValueError("motion: give a motion model to the constructor or to replan")
         cfg = self.config
         start = np.asarray(start, dtype=float)
         goal = np.asarray(goal, dtype=float)
@@ -301,13 +289,13 @@ class SequentialBITStar:
                 history = list(res.history)
             t1 = time.perf_counter()
             shapes = [s.shape for s in squares]
-            motion = motion_fn(res.path, shapes, 0.0)
-            hit = first_collision(motion, predictions, self.robot_radius, margin=cfg.margin,
+            timed_motion = motion_fn(res.path, shapes, 0.0)
+            hit = first_collision(timed_motion, predictions, self.robot_radius, margin=cfg.margin,
                                   sample_dt=cfg.prediction_dt)
             motion_time += time.perf_counter() - t1
             candidates.append((res.path, shapes))
             attempt = SequentialResult("collision_free" if hit is None else "collision_predicted",
-                                       res.path, motion, list(squares), it + 1, 0.0, hit)
+                                       res.path, timed_motion, list(squares), it + 1, 0.0, hit)
             if hit is None:
                 attempt.plan_time_s, attempt.motion_time_s, attempt.costs = plan_time, motion_time, costs
                 attempt.history = history
@@ -327,9 +315,9 @@ class SequentialBITStar:
                                    time.perf_counter() + cfg.max_time_s)
         motion_time += time.perf_counter() - t1
         if waited is not None:
-            path, shapes, delay, motion = waited
+            path, shapes, delay, waiting_motion = waited
             n = len(shapes)
-            return SequentialResult("waiting", path, motion, squares[:n], len(costs), delay, None,
+            return SequentialResult("waiting", path, waiting_motion, squares[:n], len(costs), delay, None,
                                     plan_time, motion_time, costs, history)
         if best is None:
             return SequentialResult(status if not blocked else "plan_failed", np.zeros((0, 2)), None,
@@ -360,7 +348,7 @@ class SequentialBITStar:
                                s < side)
 
     def _try_waiting(self, candidates: list[tuple[np.ndarray, list[Shape]]],
-                     predictions: Sequence[PredictedObstacle], motion_fn: MotionFn, deadline: float
+                     predictions: Sequence[PredictedObstacle], motion_fn: MotionModel, deadline: float
                      ) -> tuple[np.ndarray, list[Shape], float, TimedMotion] | None:
         if not candidates:
             return None

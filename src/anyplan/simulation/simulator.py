@@ -292,7 +292,7 @@ class Simulation:
             scenario_hash=self.scenario.content_hash(),
             dt_s=self.dt,
             wall_time_s=wall_time_s,
-            extra={**st.extra, "perception": self.sensor.record()},
+            extra={**st.extra_dict(), "perception": self.sensor.record()},
             collision_robot_caused=self.collision_robot_caused if collided else None,
             collision_approach_speed_mps=self.collision_approach_speed_mps if collided else None,
             time_lower_bound_s=bound,

@@ -1,0 +1,195 @@
+"""The online timing policy shared by the replanning agents (``seq-bitstar``, ``st-bitstar``).
+
+:class:`ReplanningAgent` decides *when* to plan and *when* a new motion takes over; subclasses
+decide *what* to plan (:meth:`ReplanningAgent._replan`) and when the current motion needs it
+(:meth:`ReplanningAgent._check`). Planning takes simulated time: a replanning decided at t plans
+from the state the robot will have at ``t + d`` on its current reference, d being the expected
+planning delay rounded up to the control period (``planning_delay``: ``"measured"`` or fixed
+seconds); a computation that outlasts d switches later (a *late plan*). The motion in use is
+re-checked every ``check_period_s`` and tracked with Kanayama's law. The bookkeeping of one
+replanning (statuses, reasons, counts) lives in :meth:`ReplanningAgent._record_replan`, into a
+:class:`~anyplan.agents.stats.SequentialStats` record. See ``docs/sequential.md`` ("Online
+execution").
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
+from anyplan.agents.stats import SequentialStats
+from anyplan.control.kanayama import KanayamaController, KanayamaGains
+from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
+from anyplan.trajectory.reference import state_at
+from anyplan.trajectory.trajectory import Trajectory
+from anyplan.world.robot import Command, RobotSpec, RobotState
+
+__all__ = ["ReplanningAgent", "MAX_BACKOFF_S"]
+
+#: Longest wait [s] between two replannings after repeated failures.
+MAX_BACKOFF_S = 2.0
+
+
+class ReplanningAgent(Agent):
+    """Replans online and tracks the reference (see the module docstring).
+
+    Args:
+        check_period_s: How often [s] the current motion is checked against the predictions.
+        min_replan_interval_s: Minimum time [s] between two replannings (unless the predicted
+            collision is closer than ``urgent_s``).
+        urgent_s: Predicted collisions closer than this [s] replan at once.
+        planning_delay: ``"measured"`` (from the wall-clock time of the computation) or a fixed
+            delay [s] by which each new motion starts after the replanning decision.
+        max_delay_s: Cap [s] on the measured delay.
+        gains: Kanayama gains.
+    """
+
+    record: SequentialStats
+    spec: RobotSpec
+    predictor: ConstantTwistPredictor
+
+    def __init__(self, *, check_period_s: float = 0.2, min_replan_interval_s: float = 0.5,
+                 urgent_s: float = 3.0, planning_delay: str | float = "measured",
+                 max_delay_s: float = 0.5, gains: KanayamaGains | None = None) -> None:
+        super().__init__()
+        if not check_period_s > 0.0:
+            raise ValueError(f"check_period_s: must be > 0, got {check_period_s}")
+        if planning_delay != "measured" and not (isinstance(planning_delay, int | float)
+                                                 and planning_delay >= 0.0):
+            raise ValueError(f"planning_delay: 'measured' or a delay >= 0 s, got {planning_delay!r}")
+        self.check_period_s = float(check_period_s)
+        self.min_replan_interval_s = float(min_replan_interval_s)
+        self.urgent_s = float(urgent_s)
+        self.planning_delay = planning_delay
+        self.max_delay_s = float(max_delay_s)
+        self.gains = gains or KanayamaGains()
+
+    # --- lifecycle -------------------------------------------------------------------------------
+    def _reset_timing(self, record: SequentialStats) -> None:
+        """Start a run: empty stats with ``record``, no motion, nothing pending."""
+        self.record = record
+        self.stats = AgentStats(record=record)
+        self.controller = KanayamaController(self.spec, self.gains, 0.05)
+        self.trajectory: Trajectory | None = None
+        self.pending: tuple[float, Trajectory] | None = None
+        self._dt: float | None = None
+        self._last_t: float | None = None
+        self._last_check = -math.inf
+        self._last_replan = -math.inf
+        self._failures = 0  # consecutive replannings without a motion
+        self._retry_at = -math.inf  # no replanning before this time [s] (back-off)
+        self._seen: set[str] = set()
+        self._requested: str | None = None
+        self.tracking = TrackingLog()
+        self.executed: list[tuple[float, Trajectory]] = []  # (switch time [s], trajectory)
+
+    # --- timing ----------------------------------------------------------------------------------
+    def _expected_delay(self, dt: float) -> float:
+        if self.planning_delay != "measured":
+            d = float(self.planning_delay)
+        else:
+            # 1.5 x the longest of the last five replannings, within [0.1 s, max_delay_s]: an
+            # outlier must not park the robot on a stale reference for long; a replanning that
+            # takes longer than expected is re-timed when it ends (see _late_switch).
+            recent = self.stats.planning_times_s[-5:]
+            d = min(max(1.5 * max(recent), 0.1), self.max_delay_s) if recent else 0.1
+        return max(dt, math.ceil(d / dt - 1e-9) * dt)
+
+    def _state_at(self, obs: Observation, t: float) -> RobotState:
+        """The state the robot will have at time ``t`` [s]: on its reference, or at rest."""
+        if self.trajectory is None:
+            r = obs.robot
+            return RobotState(r.x, r.y, r.theta, 0.0, 0.0)
+        return state_at(self.trajectory, t)
+
+    def _begin_replan(self, obs: Observation) -> tuple[float, float, float, RobotState]:
+        """``(dt, d, t_ready, state)``: the control period, the expected delay, the time the new
+        motion will start and the robot's state then."""
+        dt = self._dt or 0.05
+        d = self._expected_delay(dt)
+        t_ready = obs.t + d
+        return dt, d, t_ready, self._state_at(obs, t_ready)
+
+    def _late_switch(self, t: float, wall: float, d: float, dt: float) -> float | None:
+        """The later switch time [s] of a measured replanning that outlasted ``d`` [s] (counted
+        in ``late_plans``), or None when it was on time."""
+        if self.planning_delay == "measured" and wall > d + 1e-9:
+            self.record.late_plans += 1
+            return t + math.ceil(wall / dt - 1e-9) * dt
+        return None
+
+    def _record_replan(self, t: float, wall: float, res: Any, reason: str) -> None:
+        """Book one replanning at ``t`` [s] that took ``wall`` [s] with result ``res`` (a
+        :class:`~anyplan.planning.sequential.SequentialResult`)."""
+        self._last_replan = t
+        st, rec = self.stats, self.record
+        st.planning_times_s.append(wall)
+        if self.trajectory is not None or len(st.planning_times_s) > 1:
+            st.replans += 1
+        rec.statuses[res.status] = rec.statuses.get(res.status, 0) + 1
+        rec.iterations.append(res.iterations)
+        rec.replan_times_s.append(t)
+        rec.reasons.append(reason)
+        st.virtual_obstacles.extend(v.to_dict() for v in res.virtual_obstacles)
+
+    # --- control ---------------------------------------------------------------------------------
+    def act(self, obs: Observation) -> Command:
+        if self._last_t is not None and obs.t > self._last_t:
+            self._dt = obs.t - self._last_t
+            self.controller.dt = self._dt
+        self._last_t = obs.t
+        t = obs.t
+        preds = self.predictor.predict(obs.obstacles)
+        if self.pending is not None and t >= self.pending[0] - 1e-9:
+            self._switch()
+        if self.trajectory is None and self.pending is None:
+            # The first plan: the robot stays at rest while it is computed.
+            if t < self._retry_at - 1e-9:
+                return Command(0.0, 0.0)
+            self._replan(obs, preds, "initial")
+            self._last_check = t
+            self._seen = {p.name for p in preds}
+            if self.pending is not None and t >= self.pending[0] - 1e-9:
+                self._switch()
+        elif (self.trajectory is not None and self.pending is None
+              and (t - self._last_check >= self.check_period_s - 1e-9
+                   or self._requested is not None)):
+            self._check(obs, preds)
+        traj = self.trajectory
+        if traj is None:
+            return Command(0.0, 0.0)
+        ref = state_at(traj, t)
+        self.tracking.add((ref.x, ref.y), obs.robot, self.record)
+        return self.controller.command(traj, obs.robot, t)
+
+    def request_replan(self, reason: str) -> None:
+        """Replan at the next step (e.g. an obstacle left its predicted tube)."""
+        self._requested = reason
+
+    def _switch(self) -> None:
+        assert self.pending is not None
+        self.trajectory = self.pending[1]
+        self.executed.append(self.pending)
+        self.pending = None
+
+    def _observe_check(self, obs: Observation, preds: list[PredictedObstacle]) -> bool:
+        """Start a periodic check at ``obs.t``: note the obstacles seen; True if one is new."""
+        self._last_check = obs.t
+        names = {p.name for p in preds}
+        new = names - self._seen
+        self._seen |= names
+        return bool(new)
+
+    def _arrived(self, obs: Observation, traj: Trajectory) -> bool:
+        """The motion is over and the robot within the goal tolerance."""
+        spec = self.spec
+        return obs.t >= traj.t_end and math.hypot(obs.robot.x - spec.goal[0],
+                                                  obs.robot.y - spec.goal[1]) <= spec.goal_tolerance
+
+    # --- what subclasses provide -----------------------------------------------------------------
+    def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
+        raise NotImplementedError
+
+    def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
+        raise NotImplementedError

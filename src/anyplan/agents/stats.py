@@ -1,0 +1,161 @@
+"""Typed statistics records of the built-in agents: what each adds to ``result.json``'s ``extra``.
+
+Every record is a dataclass whose ``to_dict()`` gives the ``extra`` keys in the order the agent
+reports them; a field that is None (or an empty optional list) was never reported and is left
+out. ``WALL_CLOCK`` lists the keys that hold wall-clock measurements (the agent's
+``wall_clock_extra``: ``--deterministic`` results compare equal without them). An agent keeps
+its record in ``stats.record`` (:class:`~anyplan.agents.base.AgentStats`).
+
+Records: :class:`SequentialStats` (``seq-bitstar``), :class:`SpaceTimeStats` (``st-bitstar``),
+:class:`BITStarStats` (``bitstar``), :class:`TrackerCounts` (the ``tracking`` entry of the
+perceiving wrapper). ``straight``, ``orca`` and ``policy`` report no ``extra``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+__all__ = ["StatsRecord", "SequentialStats", "SpaceTimeStats", "BITStarStats", "TrackerCounts"]
+
+
+@dataclass
+class StatsRecord:
+    """Base of the records: ``to_dict()`` over :attr:`KEYS`, leaving out what was not reported."""
+
+    #: The ``extra`` keys, in order.
+    KEYS: ClassVar[tuple[str, ...]] = ()
+    #: Keys left out while they are None (or, for lists, empty).
+    OPTIONAL: ClassVar[frozenset[str]] = frozenset()
+    #: Keys holding wall-clock measurements.
+    WALL_CLOCK: ClassVar[tuple[str, ...]] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``result.json`` form."""
+        out: dict[str, Any] = {}
+        for k in self.KEYS:
+            v = getattr(self, k)
+            if k in self.OPTIONAL and (v is None or (isinstance(v, list) and not v)):
+                continue
+            out[k] = v
+        return out
+
+
+_TRACKING = ("tracking_rms_m", "tracking_max_m")
+
+
+@dataclass
+class SequentialStats(StatsRecord):
+    """``seq-bitstar``: one entry per replanning in the lists, unless said otherwise.
+
+    Attributes:
+        statuses: Count of each replanning status (``collision_free``, ``waiting``, ...).
+        iterations: BIT* plans per replanning.
+        late_plans: Replannings whose computation outlasted the expected delay (wall clock).
+        plan_time_s: Wall-clock time [s] of the BIT* searches.
+        motion_time_s: Wall-clock time [s] of motion building and prediction.
+        replan_times_s: Simulated time [s] of each replanning.
+        waits: Replannings that found a delayed departure.
+        fallbacks: The safety guard's fallbacks (the guard's own list).
+        safety_time_s: Wall-clock time [s] of each safety decision.
+        reasons: Why each replanning happened.
+        progress: BIT*'s cost against solve time in the first planning, ``[[t_s, cost_m], ...]``.
+        safety: Every safety decision in JSON form.
+        tracking_rms_m: RMS distance [m] between robot and reference.
+        tracking_max_m: Largest such distance [m].
+    """
+
+    KEYS: ClassVar[tuple[str, ...]] = (
+        "statuses", "iterations", "late_plans", "plan_time_s", "motion_time_s", "replan_times_s",
+        "waits", "fallbacks", "safety_time_s", "reasons", "progress", "safety", *_TRACKING)
+    OPTIONAL: ClassVar[frozenset[str]] = frozenset({"reasons", "progress", "safety", *_TRACKING})
+    WALL_CLOCK: ClassVar[tuple[str, ...]] = ("plan_time_s", "motion_time_s", "progress",
+                                             "late_plans", "safety_time_s")
+
+    statuses: dict[str, int] = field(default_factory=dict)
+    iterations: list[int] = field(default_factory=list)
+    late_plans: int = 0
+    plan_time_s: list[float] = field(default_factory=list)
+    motion_time_s: list[float] = field(default_factory=list)
+    replan_times_s: list[float] = field(default_factory=list)
+    waits: int = 0
+    fallbacks: list[dict[str, Any]] = field(default_factory=list)
+    safety_time_s: list[float] = field(default_factory=list)
+    reasons: list[str] = field(default_factory=list)
+    progress: list[list[float]] | None = None
+    safety: list[dict[str, Any]] | None = None
+    tracking_rms_m: float | None = None
+    tracking_max_m: float | None = None
+
+
+@dataclass
+class SpaceTimeStats(SequentialStats):
+    """``st-bitstar``: the fields of :class:`SequentialStats` it fills, and
+
+    Attributes:
+        st_waits_s: Planned wait [s] of each motion started.
+        st_timed: Motions started that were re-timed among the moving obstacles.
+        st_candidates: Timed candidates per replanning.
+    """
+
+    KEYS: ClassVar[tuple[str, ...]] = (
+        "statuses", "iterations", "late_plans", "plan_time_s", "motion_time_s", "replan_times_s",
+        "waits", "fallbacks", "safety_time_s", "st_waits_s", "st_timed", "st_candidates",
+        "reasons", "progress", "safety", *_TRACKING)
+
+    st_waits_s: list[float] = field(default_factory=list)
+    st_timed: int = 0
+    st_candidates: list[int] = field(default_factory=list)
+
+
+@dataclass
+class BITStarStats(StatsRecord):
+    """``bitstar`` (one plan): only ``plan_status`` when BIT* failed.
+
+    Attributes:
+        plan_status: BIT*'s status.
+        bitstar_time_s: Wall-clock time [s] of the BIT* calls.
+        motion_time_s: Wall-clock time [s] of the motion building.
+        path_cost_m: Cost [m] of BIT*'s path.
+        trajectory_kind: How the reference motion was built.
+        trajectory_certified_free: Its certification among the static obstacles.
+        smoothed_length_m: Length [m] of the smoothed path.
+        reference_duration_s: Duration [s] of the reference motion.
+        time_lower_bound_s: Its time lower bound [s].
+        smoothed_path: At most about 400 points of the smoothed path.
+        progress: BIT*'s cost against solve time, ``[[t_s, cost_m], ...]``.
+        tracking_rms_m: RMS distance [m] between robot and reference.
+        tracking_max_m: Largest such distance [m].
+    """
+
+    KEYS: ClassVar[tuple[str, ...]] = (
+        "plan_status", "bitstar_time_s", "motion_time_s", "path_cost_m", "trajectory_kind",
+        "trajectory_certified_free", "smoothed_length_m", "reference_duration_s",
+        "time_lower_bound_s", "smoothed_path", "progress", *_TRACKING)
+    OPTIONAL: ClassVar[frozenset[str]] = frozenset(KEYS)
+    WALL_CLOCK: ClassVar[tuple[str, ...]] = ("bitstar_time_s", "motion_time_s", "progress")
+
+    plan_status: str | None = None
+    bitstar_time_s: float | None = None
+    motion_time_s: float | None = None
+    path_cost_m: float | None = None
+    trajectory_kind: str | None = None
+    trajectory_certified_free: bool | None = None
+    smoothed_length_m: float | None = None
+    reference_duration_s: float | None = None
+    time_lower_bound_s: float | None = None
+    smoothed_path: list[list[float]] | None = None
+    progress: list[list[float]] | None = None
+    tracking_rms_m: float | None = None
+    tracking_max_m: float | None = None
+
+
+@dataclass
+class TrackerCounts(StatsRecord):
+    """The perceiving wrapper's ``extra.tracking``: live tracks, dropped tracks, tube exits."""
+
+    KEYS: ClassVar[tuple[str, ...]] = ("tracks", "dropped", "tube_exits")
+
+    tracks: int = 0
+    dropped: int = 0
+    tube_exits: int = 0
