@@ -148,7 +148,13 @@ AGENTS.register("dovs", "anyplan.agents.dovs:DOVSAgent")
 AGENTS.register("st-bitstar", "anyplan.agents.spacetime:SpaceTimeBITStarAgent")
 AGENTS.register("orca", "anyplan.agents.orca:ORCAAgent")  # optional extra: pyrvo
 AGENTS.register("policy", "anyplan.agents.policy:PolicyAgent")  # e.g. trained in anyplan.gym
-AGENTS.set_discovery(discover_plugins)  # third-party agents: entry-point group "anyplan.agents"
+
+
+def _discover(registry: Registry[type[Agent]]) -> None:
+    discover_plugins(registry)  # third-party agents: entry-point group "anyplan.agents"
+
+
+AGENTS.set_discovery(_discover)
 
 
 def make_agent(name: str, **config: Any) -> Agent:

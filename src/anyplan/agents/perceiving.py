@@ -51,8 +51,8 @@ class TrackingAgent(Agent):
         self._plans = 0
         self.tube_exits = 0
 
-    @property  # type: ignore[override]
-    def name(self) -> str:
+    @property
+    def name(self) -> str:  # type: ignore[override]
         return self.inner.name
 
     @property  # type: ignore[override]

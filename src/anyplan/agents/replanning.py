@@ -15,6 +15,8 @@ execution").
 from __future__ import annotations
 
 import math
+import time
+from collections.abc import Callable
 from typing import Any
 
 from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
@@ -118,6 +120,22 @@ class ReplanningAgent(Agent):
             self.record.late_plans += 1
             return t + math.ceil(wall / dt - 1e-9) * dt
         return None
+
+    def _take_up(self, obs: Observation, t_ready: float, wall: float, d: float, dt: float,
+                 motion: Trajectory | None,
+                 retime: Callable[[RobotState, float], Trajectory | None]
+                 ) -> tuple[float, Trajectory | None]:
+        """When and what the robot takes up: ``motion`` at ``t_ready`` [s]; or, when the
+        replanning (``wall`` [s]) outlasted the expected delay ``d`` [s], ``retime(state,
+        t_switch)`` from the state the robot will have at the later switch time (the robot went
+        on with its current reference meanwhile; the re-timing counts as planning time)."""
+        late = self._late_switch(obs.t, wall, d, dt)
+        if late is None:
+            return t_ready, motion
+        w1 = time.perf_counter()
+        out = retime(self._state_at(obs, late), late)
+        self.stats.planning_times_s[-1] = wall + (time.perf_counter() - w1)
+        return late, out
 
     def _record_replan(self, t: float, wall: float, res: Any, reason: str) -> None:
         """Book one replanning at ``t`` [s] that took ``wall`` [s] with result ``res`` (a

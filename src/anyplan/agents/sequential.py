@@ -137,20 +137,12 @@ class SequentialBITStarAgent(ReplanningAgent):
             self._retry_at = t + min(dt * 2.0 ** (self._failures - 1), MAX_BACKOFF_S)
             return
         self._failures = 0
-        motion: Trajectory = res.motion  # type: ignore[assignment]
-        t_switch = t_ready
-        late = self._late_switch(t, wall, d, dt)
-        if late is not None:
-            # Late: the computation outlasted the expected delay. The robot went on with its
-            # current reference (or stayed at rest) meanwhile, so the new motion is re-timed
-            # from the state it will have when the new plan is really ready. The re-timing
-            # time counts as planning time too.
-            w1 = time.perf_counter()
-            t_switch = late
-            state = self._state_at(obs, t_switch)
-            shapes = [v.shape for v in res.virtual_obstacles]
-            motion = self.reference.departing(state, t_switch)(res.path, shapes, res.delay_s)
-            self.stats.planning_times_s[-1] = wall + (time.perf_counter() - w1)
+        # Late plans are re-timed from the state the robot will have when the plan is ready.
+        t_switch, motion = self._take_up(
+            obs, t_ready, wall, d, dt, res.motion,  # type: ignore[arg-type]
+            lambda state, t_s: self.reference.departing(state, t_s)(
+                res.path, [v.shape for v in res.virtual_obstacles], res.delay_s))
+        assert motion is not None
         if self.safety:
             self._guarded(obs, motion, t_switch, t_switch - t, preds, res)
             return

@@ -226,21 +226,10 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         wall = time.perf_counter() - w0
         self._record_replan(t, wall, res, reason)
         self.record.st_candidates.append(len(self._cands))
-        t_switch = t_ready
-        late = self._late_switch(t, wall, d, dt)
-        if late is not None:
-            # Late: the computed motion starts in the past. Re-time from the state the robot
-            # will really have, on the same path (no new search).
-            w1 = time.perf_counter()
-            t_switch = late
-            state = self._state_at(obs, t_switch)
-            motion = None
-            if len(path):
-                self._cands = []
-                self._timed_fn(state, t_switch, self.max_wait_s)(np.asarray(path), shapes, 0.0)
-                if self._cands:
-                    motion = self._cands[0][1]
-            self.stats.planning_times_s[-1] = wall + (time.perf_counter() - w1)
+        # Late: the computed motion starts in the past. Re-time from the state the robot will
+        # really have, on the same path (no new search).
+        t_switch, motion = self._take_up(obs, t_ready, wall, d, dt, motion,
+                                         lambda state, t_s: self._retime_path(state, t_s, path, shapes))
         if motion is None:
             if self.trajectory is not None and verify(
                     self.trajectory, preds, self.spec.radius, t_from=t_switch,
@@ -256,6 +245,15 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                                  "virtual_obstacles": len(res.virtual_obstacles),
                                  "arrival_s": float(motion.t_end)})
         self.pending = (t_switch, motion)
+
+    def _retime_path(self, state: RobotState, t_switch: float, path: np.ndarray,
+                     shapes: list[Shape]) -> Trajectory | None:
+        """The timed motion along ``path`` from ``state`` at ``t_switch`` [s], if one exists."""
+        if not len(path):
+            return None
+        self._cands = []
+        self._timed_fn(state, t_switch, self.max_wait_s)(np.asarray(path), shapes, 0.0)
+        return self._cands[0][1] if self._cands else None
 
     def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
         t = obs.t

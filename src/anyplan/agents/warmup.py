@@ -22,7 +22,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Iterable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -44,7 +44,7 @@ class compiling_notifier:  # noqa: N801 - a context manager used like a function
     def __init__(self, callback: Callable[[], None] | None) -> None:
         self.callback = callback
         self.compiled = False
-        self._listener = None
+        self._listener: Any = None
 
     def __enter__(self) -> compiling_notifier:
         from numba.core import event
