@@ -18,13 +18,15 @@ from typing import Any, Protocol
 import numpy as np
 
 from anyplan.agents.plugins import discover_plugins
+from anyplan.agents.stats import StatsRecord
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.prediction.detection import Detection
 from anyplan.registry import LoadError, Registry
 from anyplan.world.robot import Command, RobotState
 from anyplan.world.scenario import Scenario
 
-__all__ = ["Observation", "Agent", "AgentStats", "TrackingLog", "AGENTS", "make_agent"]
+__all__ = ["Observation", "Agent", "AgentStats", "TrackingLog", "TrackedStats", "AGENTS",
+           "make_agent"]
 
 
 @dataclass(frozen=True)
@@ -65,7 +67,7 @@ class AgentStats:
     virtual_obstacles: list[dict[str, Any]] = field(default_factory=list)
     plans: list[dict[str, Any]] = field(default_factory=list)
     extra: dict[str, Any] = field(default_factory=dict)
-    record: Any = None
+    record: StatsRecord | None = None
 
     def extra_dict(self) -> dict[str, Any]:
         """``result.json``'s ``extra``: the record's fields, then :attr:`extra` (records in it

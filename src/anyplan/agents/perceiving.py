@@ -98,6 +98,10 @@ class TrackingAgent(Agent):
         if n != self._plans:
             self._plans = n
             self._tube = {p.name: p for p in self._predictor.predict(seen)}
-        self.inner.stats.extra["tracking"] = TrackerCounts(len(self.tracker), self.tracker.dropped,
-                                                           self.tube_exits)
+        counts = TrackerCounts(len(self.tracker), self.tracker.dropped, self.tube_exits)
+        st = self.inner.stats
+        if st.record is not None:
+            st.record.tracking = counts  # typed agents: the record has the slot
+        else:
+            st.extra["tracking"] = counts
         return cmd

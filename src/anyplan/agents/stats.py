@@ -20,8 +20,25 @@ __all__ = ["StatsRecord", "SequentialStats", "SpaceTimeStats", "BITStarStats", "
 
 
 @dataclass
+class TrackerCounts:
+    """The perceiving wrapper's ``extra.tracking``: live tracks, dropped tracks, tube exits."""
+
+    tracks: int = 0
+    dropped: int = 0
+    tube_exits: int = 0
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``result.json`` form."""
+        return {"tracks": self.tracks, "dropped": self.dropped, "tube_exits": self.tube_exits}
+
+
+@dataclass
 class StatsRecord:
-    """Base of the records: ``to_dict()`` over :attr:`KEYS`, leaving out what was not reported."""
+    """Base of the records: ``to_dict()`` over :attr:`KEYS`, leaving out what was not reported.
+
+    Attributes:
+        tracking: The perceiving wrapper's tracker counts (``tracked`` perception only).
+    """
 
     #: The ``extra`` keys, in order.
     KEYS: ClassVar[tuple[str, ...]] = ()
@@ -30,6 +47,8 @@ class StatsRecord:
     #: Keys holding wall-clock measurements.
     WALL_CLOCK: ClassVar[tuple[str, ...]] = ()
 
+    tracking: TrackerCounts | None = field(default=None, kw_only=True)
+
     def to_dict(self) -> dict[str, Any]:
         """The ``result.json`` form."""
         out: dict[str, Any] = {}
@@ -37,7 +56,7 @@ class StatsRecord:
             v = getattr(self, k)
             if k in self.OPTIONAL and (v is None or (isinstance(v, list) and not v)):
                 continue
-            out[k] = v
+            out[k] = v.to_dict() if isinstance(v, TrackerCounts) else v
         return out
 
 
@@ -61,14 +80,18 @@ class SequentialStats(StatsRecord):
         reasons: Why each replanning happened.
         progress: BIT*'s cost against solve time in the first planning, ``[[t_s, cost_m], ...]``.
         safety: Every safety decision in JSON form.
+        tracking: The tracker's counts (``tracked`` perception; reported from the first step,
+            before the first motion starts).
         tracking_rms_m: RMS distance [m] between robot and reference.
         tracking_max_m: Largest such distance [m].
     """
 
     KEYS: ClassVar[tuple[str, ...]] = (
         "statuses", "iterations", "late_plans", "plan_time_s", "motion_time_s", "replan_times_s",
-        "waits", "fallbacks", "safety_time_s", "reasons", "progress", "safety", *_TRACKING)
-    OPTIONAL: ClassVar[frozenset[str]] = frozenset({"reasons", "progress", "safety", *_TRACKING})
+        "waits", "fallbacks", "safety_time_s", "reasons", "progress", "safety", "tracking",
+        *_TRACKING)
+    OPTIONAL: ClassVar[frozenset[str]] = frozenset({"reasons", "progress", "safety", "tracking",
+                                                    *_TRACKING})
     WALL_CLOCK: ClassVar[tuple[str, ...]] = ("plan_time_s", "motion_time_s", "progress",
                                              "late_plans", "safety_time_s")
 
@@ -101,7 +124,7 @@ class SpaceTimeStats(SequentialStats):
     KEYS: ClassVar[tuple[str, ...]] = (
         "statuses", "iterations", "late_plans", "plan_time_s", "motion_time_s", "replan_times_s",
         "waits", "fallbacks", "safety_time_s", "st_waits_s", "st_timed", "st_candidates",
-        "reasons", "progress", "safety", *_TRACKING)
+        "reasons", "progress", "safety", "tracking", *_TRACKING)
 
     st_waits_s: list[float] = field(default_factory=list)
     st_timed: int = 0
@@ -126,12 +149,14 @@ class BITStarStats(StatsRecord):
         progress: BIT*'s cost against solve time, ``[[t_s, cost_m], ...]``.
         tracking_rms_m: RMS distance [m] between robot and reference.
         tracking_max_m: Largest such distance [m].
+        tracking: The tracker's counts (``tracked`` perception; reported after the tracking
+            error, since the motion starts in the first step).
     """
 
     KEYS: ClassVar[tuple[str, ...]] = (
         "plan_status", "bitstar_time_s", "motion_time_s", "path_cost_m", "trajectory_kind",
         "trajectory_certified_free", "smoothed_length_m", "reference_duration_s",
-        "time_lower_bound_s", "smoothed_path", "progress", *_TRACKING)
+        "time_lower_bound_s", "smoothed_path", "progress", *_TRACKING, "tracking")
     OPTIONAL: ClassVar[frozenset[str]] = frozenset(KEYS)
     WALL_CLOCK: ClassVar[tuple[str, ...]] = ("bitstar_time_s", "motion_time_s", "progress")
 
@@ -148,14 +173,3 @@ class BITStarStats(StatsRecord):
     progress: list[list[float]] | None = None
     tracking_rms_m: float | None = None
     tracking_max_m: float | None = None
-
-
-@dataclass
-class TrackerCounts(StatsRecord):
-    """The perceiving wrapper's ``extra.tracking``: live tracks, dropped tracks, tube exits."""
-
-    KEYS: ClassVar[tuple[str, ...]] = ("tracks", "dropped", "tube_exits")
-
-    tracks: int = 0
-    dropped: int = 0
-    tube_exits: int = 0
