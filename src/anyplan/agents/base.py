@@ -122,8 +122,9 @@ class Agent(abc.ABC):
 
     #: Registry name, set by subclasses.
     name: str = "agent"
-    #: Dataclasses whose fields the constructor also accepts as keywords (``--set`` lists them).
-    config_classes: tuple[type, ...] = ()
+    #: Dataclasses (or instances: their values are the defaults) whose fields the constructor also
+    #: accepts as keywords (``--set`` lists them).
+    config_classes: tuple[Any, ...] = ()
     #: Settings that make a run depend only on scenario, settings and seed (``--deterministic``);
     #: ``{}`` for an agent that is deterministic as it is, None for one without such a mode.
     deterministic_settings: dict[str, Any] | None = None

@@ -24,7 +24,6 @@ from anyplan.agents.stats import BITStarStats
 from anyplan.agents.warmup import warm_up_kernels
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
 from anyplan.trajectory.motion import plan_motion
-from anyplan.trajectory.reference import state_at
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import Command, RobotState
 from anyplan.world.scenario import Scenario
@@ -135,7 +134,7 @@ class BITStarAgent(Agent):
         traj = self.trajectory
         if traj is None:
             return Command(0.0, 0.0)
-        ref = state_at(traj, obs.t)
+        ref = traj.state(obs.t)
         self.tracking.add((ref.x, ref.y), obs.robot, self.record)
         return self.controller.command(traj, obs.robot, obs.t)
 
@@ -143,4 +142,4 @@ class BITStarAgent(Agent):
         """The reference state at time ``t`` [s], or None before planning."""
         if self.trajectory is None:
             return None
-        return state_at(self.trajectory, t)
+        return self.trajectory.state(t)

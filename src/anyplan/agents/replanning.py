@@ -23,7 +23,6 @@ from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
 from anyplan.agents.stats import SequentialStats
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
-from anyplan.trajectory.reference import state_at
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import Command, RobotSpec, RobotState
 
@@ -103,7 +102,7 @@ class ReplanningAgent(Agent):
         if self.trajectory is None:
             r = obs.robot
             return RobotState(r.x, r.y, r.theta, 0.0, 0.0)
-        return state_at(self.trajectory, t)
+        return self.trajectory.state(t)
 
     def _begin_replan(self, obs: Observation) -> tuple[float, float, float, RobotState]:
         """``(dt, d, t_ready, state)``: the control period, the expected delay, the time the new
@@ -177,7 +176,7 @@ class ReplanningAgent(Agent):
         traj = self.trajectory
         if traj is None:
             return Command(0.0, 0.0)
-        ref = state_at(traj, t)
+        ref = traj.state(t)
         self.tracking.add((ref.x, ref.y), obs.robot, self.record)
         return self.controller.command(traj, obs.robot, t)
 

@@ -26,7 +26,7 @@ from anyplan.geometry.moving import closest_approach
 from anyplan.prediction.base import PredictedObstacle
 from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.motion import brake_to_rest, polyline_trajectory
-from anyplan.trajectory.reference import HoldSegment, come_to_rest, state_at
+from anyplan.trajectory.reference import HoldSegment, come_to_rest
 from anyplan.trajectory.trajectory import BrakeSegment, Trajectory
 from anyplan.world.robot import RobotSpec, RobotState
 
@@ -79,7 +79,7 @@ class Escape:
                  radius: float) -> None:
         self.motion = motion
         self.t_commit = float(min(max(t_commit, motion.t_start), motion.t_end))
-        st = state_at(motion, self.t_commit)
+        st = motion.state(self.t_commit)
         segs, t_rest, _, free = brake_to_rest(st, spec, obstacles, radius, self.t_commit)
         self.brake: BrakeSegment | None = segs[0] if segs else None  # type: ignore[assignment]
         self.t_rest = float(t_rest)

@@ -28,6 +28,7 @@ from anyplan.agents.stats import SpaceTimeStats
 from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import MotionModel, SequentialConfig, SequentialResult
 from anyplan.prediction.base import PredictedObstacle
+from anyplan.trajectory.kinds import ST_PREFIX, MotionKind
 from anyplan.trajectory.spacetime import retime, verify
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import RobotState
@@ -180,7 +181,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                   reason: str) -> Trajectory:
         """Brake to rest on the current reference (or stay) and hold."""
         state = self._state_at(obs, t_switch)
-        tr, t_rest = self.reference.hold(state, t_switch, 1e4, kind="fallback-hold",
+        tr, t_rest = self.reference.hold(state, t_switch, 1e4, kind=MotionKind.FALLBACK_HOLD,
                                          stop_rotation=False)
         hit = verify(tr, preds, self.spec.radius, t_until=t_rest + 10.0) if preds else None
         self.record.fallbacks.append(
@@ -238,7 +239,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             motion = self._fallback(obs, t_switch, preds, res.status)
         else:
             self._path, self._shapes = np.asarray(path), list(shapes)
-            self.record.st_timed += int(motion.kind.startswith("st+"))
+            self.record.st_timed += int(motion.kind.startswith(ST_PREFIX))
             self.record.st_waits_s.append(float(motion.info.get("wait_s", 0.0)))
         self.stats.plans.append({"t": t, "t_start": t_switch, "path": np.asarray(path).tolist(),
                                  "status": res.status, "kind": motion.kind,
@@ -263,7 +264,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         spec = self.spec
         if self._arrived(obs, traj):
             return
-        if traj.kind == "fallback-hold" and t - self._last_replan >= self.min_replan_interval_s:
+        if traj.kind == MotionKind.FALLBACK_HOLD and t - self._last_replan >= self.min_replan_interval_s:
             self._replan(obs, preds, "holding")
             return
         hit = verify(traj, preds, spec.radius, t_from=t,

@@ -16,23 +16,26 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.shapes import Shape
+from anyplan.trajectory.kinds import SegmentKind
 from anyplan.trajectory.motion import brake_to_rest, continue_from, plan_motion
 from anyplan.trajectory.trajectory import BrakeSegment, Segment, Trajectory
 from anyplan.world.robot import RobotSpec, RobotState
 
-__all__ = ["HoldSegment", "ReferenceBuilder", "Departure", "come_to_rest", "state_at"]
+__all__ = ["HoldSegment", "ReferenceBuilder", "Departure", "come_to_rest", "WAIT_PREFIX"]
+
+#: Prefix of the kind of a motion departing late (``"wait+smooth"``, ...).
+WAIT_PREFIX = "wait+"
 
 
 class HoldSegment(Segment):
     """Standing still at (x, y, theta) from ``t0`` to ``t1`` [s]."""
 
-    kind = "hold"
+    kind = SegmentKind.HOLD
 
     def __init__(self, x: float, y: float, theta: float, t0: float, t1: float) -> None:
         self.x, self.y, self.theta = float(x), float(y), float(theta)
@@ -47,12 +50,6 @@ class HoldSegment(Segment):
 
     def path_points(self, step: float) -> np.ndarray:
         return np.array([[self.x, self.y]])
-
-
-def state_at(motion: Any, t: float) -> RobotState:
-    """The reference state of ``motion`` (a :class:`Trajectory`) at time ``t`` [s]."""
-    s = motion.state(t)
-    return s if isinstance(s, RobotState) else RobotState(*s)
 
 
 def come_to_rest(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: float,
@@ -138,6 +135,6 @@ class Departure:
                           spec.radius + self.margin)
         tail = plan_motion(p, spec, rest, obst, t + delay_s, margin=self.margin,
                            grid_step=b.grid_step)
-        return Trajectory(segs + tail.segments, kind="wait+" + tail.kind, feasible=tail.feasible,
+        return Trajectory(segs + tail.segments, kind=WAIT_PREFIX + tail.kind, feasible=tail.feasible,
                           lower_bound_s=tail.lower_bound_s, polyline=tail.polyline,
                           info=tail.info, certified_free=tail.certified_free)
