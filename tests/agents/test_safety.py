@@ -63,7 +63,7 @@ def test_far_collision_is_stoppable_near_one_is_not():
 
 def test_current_motion_is_kept_when_the_new_one_is_unsafe():
     guard = SafetyGuard(SPEC, ROOM)
-    state, motion = _cruising()
+    _state, motion = _cruising()
     # The proposed motion drives into a disc 0.9 m ahead; the current one is parked in place.
     hold = guard.fallback(0.0, RobotState(1.0, 4.0, 0.0, 0.0, 0.0), [])
     d = guard.decide(0.0, motion, hold.trajectory, RobotState(1.0, 4.0, 0.0, 0.0, 0.0),

@@ -60,7 +60,7 @@ class ORCAAgent(Agent):
                  max_neighbors: int = 30, safety_m: float = 0.05,
                  uncertainty_horizon_s: float = 1.0) -> None:
         super().__init__()
-        import pyrvo  # type: ignore[import-untyped]  # noqa: F401  (fail at construction when the extra is missing)
+        import pyrvo  # noqa: F401  (fail at construction when the extra is missing)
 
         self.period_s = period_s
         self.time_horizon_s = time_horizon_s
@@ -112,7 +112,7 @@ class ORCAAgent(Agent):
     def act(self, obs: Observation) -> Command:
         if self._next_t is not None and obs.t < self._next_t - 1e-9:
             return self._held
-        import pyrvo  # type: ignore[import-untyped]
+        import pyrvo
 
         w0 = time.perf_counter()
         r = obs.robot

@@ -55,7 +55,7 @@ class TrackingAgent(Agent):
     def name(self) -> str:  # type: ignore[override]
         return self.inner.name
 
-    @property  # type: ignore[override]
+    @property
     def stats(self) -> AgentStats:
         return self.inner.stats
 

@@ -113,7 +113,7 @@ class SequentialStats(StatsRecord):
 
 @dataclass
 class SpaceTimeStats(SequentialStats):
-    """``st-bitstar``: the fields of :class:`SequentialStats` it fills, and
+    """``st-bitstar``: the fields of :class:`SequentialStats` it fills, and its own.
 
     Attributes:
         st_waits_s: Planned wait [s] of each motion started.

@@ -82,7 +82,8 @@ def _scene():  # noqa: ANN202 - small fixture shared by the motion and sequentia
     from anyplan.geometry.shapes import Circle, square
     from anyplan.world.robot import RobotSpec
 
-    obs = ObstacleSet([Circle((2.0, 2.0), 0.4), square((2.0, 0.9), 0.3)], bounds=(0.0, 0.0, 4.0, 4.0))
+    obs = ObstacleSet([Circle(np.array([2.0, 2.0]), 0.4), square((2.0, 0.9), 0.3)],
+                      bounds=(0.0, 0.0, 4.0, 4.0))
     spec = RobotSpec(start=(0.5, 0.5, 0.0), goal=(3.5, 3.5), radius=0.2)
     return obs, spec
 
