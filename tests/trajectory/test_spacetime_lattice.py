@@ -143,3 +143,31 @@ def test_lattice_dt_hits_v_max_exactly():
         dt, k = lattice_dt(v, a)
         assert k * a * dt == pytest.approx(v)
         assert k >= 2
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_capped_search_gives_the_exhaustive_answer(seed):
+    # The search ends once no queued node can arrive within the horizon (plan_velocity's cap):
+    # on random maps, blocked for ever or not, with and without start speeds off the lattice and
+    # coarse keys, the answer is the exhaustive search's, bit for bit.
+    rng = np.random.default_rng(100 + seed)
+    length = float(rng.uniform(1.0, 4.0))
+    x0, x1 = _caps(length)
+    i = int(rng.integers(0, len(x0)))
+    x0[i:i + 10] = x1[i:i + 10] = 0.2 ** 2  # a slow stretch
+    forbidden = np.zeros((int(rng.integers(150, 400)), len(x0)), dtype=bool)
+    for _ in range(int(rng.integers(2, 8))):
+        c, j = rng.integers(0, len(x0) - 3), rng.integers(0, forbidden.shape[0] - 10)
+        forbidden[j:j + rng.integers(10, 120), c:c + rng.integers(1, 8)] = True
+    if seed % 3 == 0:
+        forbidden[:, len(x0) // 2] = True  # never passable: no motion
+    forbidden[:4, :3] = False
+    horizon = float(rng.uniform(3.0, forbidden.shape[0] * H))
+    v0 = 0.0 if seed % 2 else float(rng.uniform(0.0, V))
+    for key in (0, 4):
+        a, b = (plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, v0, A, V,
+                              horizon_s=horizon, key_cells=key, cap=cap) for cap in (True, False))
+        assert (a is None) == (b is None)
+        if a is not None and b is not None:
+            for f in ("t", "s", "v", "a"):
+                assert np.array_equal(getattr(a, f), getattr(b, f))

@@ -14,12 +14,12 @@ Design and measurements: ``docs/spacetime.md`` ("Design: path-velocity decomposi
 
 from __future__ import annotations
 
-import heapq
 import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+
+from anyplan.trajectory.spacetime._lattice_kernels import LatticeMap, edge_ok, goal_times, search
 
 __all__ = ["VelocityPlan", "plan_velocity", "lattice_dt", "edge_ok", "goal_times"]
 
@@ -68,163 +68,10 @@ def lattice_dt(v_max: float, a_max: float, target_dt: float = 0.25) -> tuple[flo
     return v_max / (a_max * k), k
 
 
-@njit(cache=True)
-def edge_ok(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap0: np.ndarray,
-            xcap1: np.ndarray, t_a: float, s_a: float, v_a: float, acc: float, dur: float) -> bool:
-    """True if the step from (t_a, s_a, v_a) with acceleration ``acc`` for ``dur`` seconds keeps
-    the speed limit and touches no forbidden cell (rows beyond the map count as forbidden)."""
-    ncell = forbidden.shape[1]
-    nrow = forbidden.shape[0]
-    s_b = s_a + v_a * dur + 0.5 * acc * dur * dur
-    v_b = v_a + acc * dur
-    if v_b < -1e-9:
-        return False
-    x_hi = max(v_a * v_a, v_b * v_b)
-    c0 = min(max(int(s_a / ds), 0), ncell - 1)
-    c1 = min(max(int(s_b / ds), 0), ncell - 1)
-    if x_hi > 1e-12:
-        for c in range(c0, c1 + 1):
-            cap = xcap1[c] if acc != 0.0 else xcap0[c]
-            if x_hi > cap * (1.0 + 1e-9) + 1e-12:
-                return False
-    j0 = int(math.floor((t_a - t_map) / h + 1e-9))
-    j1 = int(math.floor((t_a + dur - t_map) / h - 1e-9))
-    if j0 < 0:
-        j0 = 0
-    if j1 >= nrow:
-        return False
-    for j in range(j0, j1 + 1):
-        ta = max(t_a, t_map + j * h) - t_a
-        tb = min(t_a + dur, t_map + (j + 1) * h) - t_a
-        sa = s_a + v_a * ta + 0.5 * acc * ta * ta
-        sb = s_a + v_a * tb + 0.5 * acc * tb * tb
-        ca = min(max(int(sa / ds), 0), ncell - 1)
-        cb = min(max(int(sb / ds), 0), ncell - 1)
-        for c in range(ca, cb + 1):
-            if forbidden[j, c]:
-                return False
-    return True
-
-
-@njit(cache=True)
-def _to_go(d: float, v: float, a: float, v_max: float) -> float:
-    """Least time [s] to cover ``d`` [m] from speed ``v`` and stop, ignoring obstacles."""
-    if d <= 0.0:
-        return v / a
-    if v * v >= 2.0 * a * d:
-        return v / a
-    vp = math.sqrt(a * d + 0.5 * v * v)
-    if vp <= v_max:
-        return (vp - v) / a + vp / a
-    cruise = d - (v_max * v_max - v * v) / (2.0 * a) - v_max * v_max / (2.0 * a)
-    return (v_max - v) / a + v_max / a + cruise / v_max
-
-
-@njit(cache=True)
-def goal_times(forbidden: np.ndarray, t_map: float, h: float, c_goal: int, reach: int,
-               ds: float, v_max: float) -> np.ndarray:
-    """Lower bounds G[j, c] [s] on the arrival at the goal cell from cell c at time t_map + j h.
-
-    The relaxation of every lattice motion: within a row the robot advances by at most ``reach``
-    cells (v_max h / ds, rounded up, plus one), through free cells of that row, with unbounded
-    acceleration; each bound is also raised to the distance bound t + (c_goal - c - 1) ds / v_max
-    (the max of two lower bounds is one). Backward over the rows; inf marks cells from which the
-    goal cannot be reached within the map (the search drops them).
-    """
-    nrow, ncell = forbidden.shape
-    g = np.full((nrow + 1, ncell), np.inf)
-    for c in range(c_goal, ncell):
-        g[nrow, c] = t_map + nrow * h
-    for j in range(nrow - 1, -1, -1):
-        tj = t_map + j * h
-        for c in range(ncell):
-            if c >= c_goal:
-                g[j, c] = tj
-                continue
-            if forbidden[j, c]:
-                continue
-            best = np.inf
-            for c2 in range(c, min(c + reach, ncell - 1) + 1):
-                if forbidden[j, c2]:
-                    break
-                if c2 >= c_goal:
-                    best = tj
-                    break
-                if g[j + 1, c2] < best:
-                    best = g[j + 1, c2]
-            g[j, c] = max(best, tj + (c_goal - c - 1) * ds / v_max)
-    return g
-
-
-@njit(cache=True)
-def _search(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap0: np.ndarray,
-            xcap1: np.ndarray, t_a: float, s_a: float, k_a: int, a: float, dt: float, kmax: int,
-            m_goal: int, n_max: int, key_cells: int, gt: np.ndarray) -> np.ndarray:
-    """A* over lattice nodes (step n, m, k), cost = time, heuristic = the larger of the
-    obstacle-free time to go and the relaxed bound ``gt`` of :func:`goal_times` (both admissible);
-    returns the accelerations (-1, 0, 1) of the earliest motion from
-    (m=0, k=k_a) at t_a to (m_goal, 0), or [-9] if none within n_max steps."""
-    delta = 0.5 * a * dt * dt
-    vstep = a * dt
-    nm = m_goal + 1
-    s_goal = s_a + m_goal * delta
-    parent = np.zeros((n_max + 1, nm, kmax + 1), dtype=np.int8)
-    parent[0, 0, k_a] = 4
-    # One node per (step, map cell, speed): two lattice points in one cell at one speed and
-    # time differ by less than a cell; keeping the first (best f) bounds the search by the map.
-    ncell = forbidden.shape[1]
-    seen = np.zeros((n_max + 1, ncell, kmax + 1), dtype=np.bool_)
-    heap = [(_to_go(s_goal - s_a, k_a * vstep, a, kmax * vstep), 0, 0, 0, k_a)]
-    found = -1
-    while len(heap) > 0:
-        _, _, n, m, k = heapq.heappop(heap)
-        if m == m_goal and k == 0:
-            found = n
-            break
-        if n >= n_max:
-            continue
-        s = s_a + m * delta
-        v = k * vstep
-        t = t_a + n * dt
-        for u in (1, 0, -1):
-            k2 = k + u
-            if k2 < 0 or k2 > kmax:
-                continue
-            m2 = m + 2 * k + u
-            if m2 > m_goal or parent[n + 1, m2, k2] != 0:
-                continue
-            key = min(int((s_a + m2 * delta) / (max(key_cells, 1) * ds)), ncell - 1)
-            if key_cells > 0 and seen[n + 1, key, k2] and m2 != m_goal:
-                continue
-            if not edge_ok(forbidden, t_map, h, ds, xcap0, xcap1, t, s, v, u * a, dt):
-                continue
-            s2 = s_a + m2 * delta
-            t2 = t + dt
-            j2 = min(max(int((t2 - t_map) / h + 1e-9), 0), gt.shape[0] - 1)
-            g2 = gt[j2, min(max(int(s2 / ds), 0), ncell - 1)]
-            if g2 == np.inf:
-                continue  # the goal cannot be reached from there within the map
-            parent[n + 1, m2, k2] = u + 2
-            seen[n + 1, key, k2] = True
-            f = t2 + max(_to_go(s_goal - s2, k2 * vstep, a, kmax * vstep), g2 - t2)
-            heapq.heappush(heap, (f, -m2, n + 1, m2, k2))
-    if found < 0:
-        return np.full(1, -9, dtype=np.int64)
-    acts = np.empty(found, dtype=np.int64)
-    m, k = m_goal, 0
-    for n in range(found, 0, -1):
-        u = int(parent[n, m, k]) - 2
-        acts[n - 1] = u
-        k_prev = k - u
-        m = m - 2 * k_prev - u
-        k = k_prev
-    return acts
-
-
 def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap0: np.ndarray,
                   xcap1: np.ndarray, length: float, t0: float, v0: float, a_max: float,
                   v_max: float, *, target_dt: float = 0.25, horizon_s: float = 60.0,
-                  key_cells: int = 4) -> VelocityPlan | None:
+                  key_cells: int = 4, cap: bool = True) -> VelocityPlan | None:
     """The earliest lattice motion from (t0, s=0, v0) to rest at (about) the path's end.
 
     Args:
@@ -246,6 +93,8 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
             found is collision-free either way, but it may arrive a step or two later than the
             lattice optimum, and a gap narrower than the key may be missed. 0 keeps every node
             (the exact lattice optimum).
+        cap: End a search once no node left can arrive within the horizon (the same answer,
+            sooner; False runs it to exhaustion, for tests).
 
     Returns:
         The :class:`VelocityPlan`, or None if no lattice motion reaches the end in the horizon.
@@ -272,6 +121,7 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
     ncell = forbidden.shape[1]
     c_goal = min(int(math.floor((length - 2.0 * delta) / ds)), ncell - 1)
     reach = int(math.ceil(v_max * h / ds)) + 1
+    lm = LatticeMap(forbidden, float(t_map), float(h), float(ds), xcap0, xcap1)
     gt = goal_times(forbidden, float(t_map), float(h), max(c_goal, 0), reach, float(ds),
                     float(v_max))
     best: VelocityPlan | None = None
@@ -281,9 +131,11 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
             m_goal -= 1  # m + k keeps its parity on the lattice; at rest k = 0
         if m_goal < 0:
             continue
-        acts = _search(forbidden, float(t_map), float(h), float(ds), xcap0, xcap1, float(t_a),
-                       float(s_a), int(k_a), float(a_max), float(dt), int(kmax), int(m_goal), n_max,
-                       int(key_cells), gt)
+        # No motion found by the search arrives after t_a + n_max dt: the cap (1e-6 s for
+        # rounding) ends a search that cannot succeed, with the same answer (see search).
+        acts = search(lm, gt, float(t_a), float(s_a), int(k_a), float(a_max), float(dt),
+                      int(kmax), int(m_goal), n_max, int(key_cells),
+                      float(t_a) + n_max * float(dt) + 1e-6 if cap else math.inf)
         if len(acts) == 1 and acts[0] == -9:
             continue
         ks = np.concatenate([[k_a], k_a + np.cumsum(acts)])

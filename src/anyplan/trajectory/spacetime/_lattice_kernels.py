@@ -1,0 +1,197 @@
+"""Compiled kernels of the s-t velocity lattice (:mod:`~anyplan.trajectory.spacetime.lattice`).
+
+The lattice, the relaxed goal-time bound and the A* search are described in that module and in
+``docs/spacetime.md``; :func:`~anyplan.trajectory.spacetime.lattice.plan_velocity` is the only
+caller of :func:`search` and :func:`goal_times`, and builds the :class:`LatticeMap` record.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+__all__ = ["LatticeMap", "edge_ok", "goal_times", "search", "to_go"]
+
+
+class LatticeMap(NamedTuple):
+    """The s-t map and speed caps one search runs on (fields as in ``plan_velocity``)."""
+
+    forbidden: np.ndarray
+    t_map: float
+    h: float
+    ds: float
+    xcap0: np.ndarray
+    xcap1: np.ndarray
+
+
+@njit(cache=True)
+def edge_ok(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap0: np.ndarray,
+            xcap1: np.ndarray, t_a: float, s_a: float, v_a: float, acc: float, dur: float) -> bool:
+    """True if the step from (t_a, s_a, v_a) with acceleration ``acc`` for ``dur`` seconds keeps
+    the speed limit and touches no forbidden cell (rows beyond the map count as forbidden)."""
+    ncell = forbidden.shape[1]
+    nrow = forbidden.shape[0]
+    s_b = s_a + v_a * dur + 0.5 * acc * dur * dur
+    v_b = v_a + acc * dur
+    if v_b < -1e-9:
+        return False
+    x_hi = max(v_a * v_a, v_b * v_b)
+    c0 = min(max(int(s_a / ds), 0), ncell - 1)
+    c1 = min(max(int(s_b / ds), 0), ncell - 1)
+    if x_hi > 1e-12:
+        for c in range(c0, c1 + 1):
+            cap = xcap1[c] if acc != 0.0 else xcap0[c]
+            if x_hi > cap * (1.0 + 1e-9) + 1e-12:
+                return False
+    j0 = int(math.floor((t_a - t_map) / h + 1e-9))
+    j1 = int(math.floor((t_a + dur - t_map) / h - 1e-9))
+    if j0 < 0:
+        j0 = 0
+    if j1 >= nrow:
+        return False
+    for j in range(j0, j1 + 1):
+        ta = max(t_a, t_map + j * h) - t_a
+        tb = min(t_a + dur, t_map + (j + 1) * h) - t_a
+        sa = s_a + v_a * ta + 0.5 * acc * ta * ta
+        sb = s_a + v_a * tb + 0.5 * acc * tb * tb
+        ca = min(max(int(sa / ds), 0), ncell - 1)
+        cb = min(max(int(sb / ds), 0), ncell - 1)
+        for c in range(ca, cb + 1):
+            if forbidden[j, c]:
+                return False
+    return True
+
+
+@njit(cache=True)
+def to_go(d: float, v: float, a: float, v_max: float) -> float:
+    """Least time [s] to cover ``d`` [m] from speed ``v`` and stop, ignoring obstacles."""
+    if d <= 0.0:
+        return v / a
+    if v * v >= 2.0 * a * d:
+        return v / a
+    vp = math.sqrt(a * d + 0.5 * v * v)
+    if vp <= v_max:
+        return (vp - v) / a + vp / a
+    cruise = d - (v_max * v_max - v * v) / (2.0 * a) - v_max * v_max / (2.0 * a)
+    return (v_max - v) / a + v_max / a + cruise / v_max
+
+
+@njit(cache=True)
+def goal_times(forbidden: np.ndarray, t_map: float, h: float, c_goal: int, reach: int,
+               ds: float, v_max: float) -> np.ndarray:
+    """Lower bounds G[j, c] [s] on the arrival at the goal cell from cell c at time t_map + j h.
+
+    The relaxation of every lattice motion: within a row the robot advances by at most ``reach``
+    cells (v_max h / ds, rounded up, plus one), through free cells of that row, with unbounded
+    acceleration; each bound is also raised to the distance bound t + (c_goal - c - 1) ds / v_max
+    (the max of two lower bounds is one). Backward over the rows; inf marks cells from which the
+    goal cannot be reached within the map (the search drops them).
+    """
+    nrow, ncell = forbidden.shape
+    g = np.full((nrow + 1, ncell), np.inf)
+    for c in range(c_goal, ncell):
+        g[nrow, c] = t_map + nrow * h
+    for j in range(nrow - 1, -1, -1):
+        tj = t_map + j * h
+        for c in range(ncell):
+            if c >= c_goal:
+                g[j, c] = tj
+                continue
+            if forbidden[j, c]:
+                continue
+            best = np.inf
+            for c2 in range(c, min(c + reach, ncell - 1) + 1):
+                if forbidden[j, c2]:
+                    break
+                if c2 >= c_goal:
+                    best = tj
+                    break
+                if g[j + 1, c2] < best:
+                    best = g[j + 1, c2]
+            g[j, c] = max(best, tj + (c_goal - c - 1) * ds / v_max)
+    return g
+
+
+@njit(cache=True)
+def search(lm: LatticeMap, gt: np.ndarray, t_a: float, s_a: float, k_a: int, a: float, dt: float,
+           kmax: int, m_goal: int, n_max: int, key_cells: int, t_cap: float) -> np.ndarray:
+    """A* over lattice nodes (step n, m, k), cost = time, heuristic = the larger of the
+    obstacle-free time to go and the relaxed bound ``gt`` of :func:`goal_times` (both admissible);
+    returns the accelerations (-1, 0, 1) of the earliest motion from
+    (m=0, k=k_a) at t_a to (m_goal, 0), or [-9] if none within n_max steps.
+
+    ``t_cap`` (inf: no cap) ends the search without a motion as soon as the least estimate f
+    popped exceeds it; :func:`~anyplan.trajectory.spacetime.lattice.plan_velocity` passes the
+    latest arrival t_a + n_max dt (plus 1e-6 s for rounding). That changes no answer. Proof: f
+    is a lower bound on the arrival of every motion through its node (admissible heuristic, to
+    ~1e-9 s), and every arrival found is at most t_a + n_max dt. While the goal G of the motion
+    the full search returns is not popped, the queue holds a node of G's parent chain (the first
+    one not yet popped was pushed when its parent was expanded), whose f <= arrival(G) <= t_cap:
+    so a node with f > t_cap is never popped before G, and until then both searches pop the same
+    nodes and set the same marks. When the full search finds no motion, the capped one finds
+    none either (it pops a subset of the same sequence). Once the least f exceeds t_cap, every
+    later node descends from a node whose motions all arrive after t_cap: none reaches the goal
+    in time, so the full search would end without a motion too.
+    """
+    forbidden, t_map, h, ds, xcap0, xcap1 = lm.forbidden, lm.t_map, lm.h, lm.ds, lm.xcap0, lm.xcap1
+    delta = 0.5 * a * dt * dt
+    vstep = a * dt
+    nm = m_goal + 1
+    s_goal = s_a + m_goal * delta
+    parent = np.zeros((n_max + 1, nm, kmax + 1), dtype=np.int8)
+    parent[0, 0, k_a] = 4
+    # One node per (step, map cell, speed): two lattice points in one cell at one speed and
+    # time differ by less than a cell; keeping the first (best f) bounds the search by the map.
+    ncell = forbidden.shape[1]
+    seen = np.zeros((n_max + 1, ncell, kmax + 1), dtype=np.bool_)
+    heap = [(to_go(s_goal - s_a, k_a * vstep, a, kmax * vstep), 0, 0, 0, k_a)]
+    found = -1
+    while len(heap) > 0:
+        f0, _, n, m, k = heapq.heappop(heap)
+        if m == m_goal and k == 0:
+            found = n
+            break
+        if f0 > t_cap:
+            break  # every node left arrives after the latest arrival (see the docstring)
+        if n >= n_max:
+            continue
+        s = s_a + m * delta
+        v = k * vstep
+        t = t_a + n * dt
+        for u in (1, 0, -1):
+            k2 = k + u
+            if k2 < 0 or k2 > kmax:
+                continue
+            m2 = m + 2 * k + u
+            if m2 > m_goal or parent[n + 1, m2, k2] != 0:
+                continue
+            key = min(int((s_a + m2 * delta) / (max(key_cells, 1) * ds)), ncell - 1)
+            if key_cells > 0 and seen[n + 1, key, k2] and m2 != m_goal:
+                continue
+            if not edge_ok(forbidden, t_map, h, ds, xcap0, xcap1, t, s, v, u * a, dt):
+                continue
+            s2 = s_a + m2 * delta
+            t2 = t + dt
+            j2 = min(max(int((t2 - t_map) / h + 1e-9), 0), gt.shape[0] - 1)
+            g2 = gt[j2, min(max(int(s2 / ds), 0), ncell - 1)]
+            if g2 == np.inf:
+                continue  # the goal cannot be reached from there within the map
+            parent[n + 1, m2, k2] = u + 2
+            seen[n + 1, key, k2] = True
+            f = t2 + max(to_go(s_goal - s2, k2 * vstep, a, kmax * vstep), g2 - t2)
+            heapq.heappush(heap, (f, -m2, n + 1, m2, k2))
+    if found < 0:
+        return np.full(1, -9, dtype=np.int64)
+    acts = np.empty(found, dtype=np.int64)
+    m, k = m_goal, 0
+    for n in range(found, 0, -1):
+        u = int(parent[n, m, k]) - 2
+        acts[n - 1] = u
+        k_prev = k - u
+        m = m - 2 * k_prev - u
+        k = k_prev
+    return acts
