@@ -71,3 +71,40 @@ def test_collisions_are_sorted_and_per_obstacle():
     hits = predict_collisions(motion, obs, 0.3)
     assert [h.obstacle for h in hits] == ["early", "late"]
     assert hits[0].t < hits[1].t
+
+
+def _same(a, b):
+    if a is None or b is None:
+        return a is b
+    if isinstance(a, list):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    return (a.obstacle, a.t, a.obstacle_radius) == (b.obstacle, b.t, b.obstacle_radius) and \
+        np.array_equal(a.robot_position, b.robot_position) and \
+        np.array_equal(a.obstacle_position, b.obstacle_position)
+
+
+def test_repeated_checks_give_the_direct_answers():
+    # Answers are remembered for the last few (motion, obstacles, settings): a repeated check
+    # equals a fresh computation, and other settings or other obstacle objects are not mixed up.
+    from anyplan.prediction import collision
+
+    motion = MOTIONS[5.0]
+    obs = [PredictedObstacle("early", 0.3, UnicycleMotion(4.0, 4.04, np.pi / 2, 0.12)),
+           PredictedObstacle("late", 0.3, UnicycleMotion(11.0, 10.1, -np.pi / 2, 0.2))]
+    calls = [{"margin": 0.0}, {"margin": 0.2}, {"margin": 0.0, "t_until": 10.0},
+             {"margin": 0.0, "sample_dt": 0.02}, {"margin": 0.0, "t_from": 30.0}]
+    fresh = []
+    for kw in calls:
+        collision._MEMO.clear()
+        fresh.append((first_collision(motion, obs, 0.3, **kw), predict_collisions(motion, obs, 0.3, **kw)))
+    collision._MEMO.clear()
+    for _ in range(2):
+        for kw, (first, every) in zip(calls, fresh, strict=True):
+            assert _same(first_collision(motion, obs, 0.3, **kw), first)
+            assert _same(predict_collisions(motion, obs, 0.3, **kw), every)
+    moved = [PredictedObstacle("early", 0.3, UnicycleMotion(4.0, 1.0, np.pi / 2, 0.12)), obs[1]]
+    collision._MEMO.clear()
+    direct = first_collision(motion, moved, 0.3)
+    first_collision(motion, obs, 0.3)
+    again = first_collision(motion, moved, 0.3)
+    assert _same(again, direct) and not _same(again, first_collision(motion, obs, 0.3))

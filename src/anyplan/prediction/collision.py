@@ -126,11 +126,36 @@ def predict_collisions(motion: TimedMotion, obstacles: Sequence[PredictedObstacl
     return _predict(motion, obstacles, robot_radius, t_from, t_until, margin, tol, sample_dt, False)
 
 
+#: The last few answers of :func:`_predict`, newest last: (motion, obstacles, settings, answer).
+#: A planner often checks the same motion against the same predictions twice in a row (the
+#: candidate's own check, then the loop's); the entries hold their motion and obstacles, so an
+#: ``id`` seen here is the same live object, and motions and predictions do not change once built.
+_MEMO: list[tuple[object, tuple[object, ...], tuple[float | bool | None, ...],
+                  list[PredictedCollision]]] = []
+_MEMO_SIZE = 8
+
+
 def _predict(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], robot_radius: float,
              t_from: float | None, t_until: float | None, margin: float, tol: float,
              sample_dt: float | None, first_only: bool) -> list[PredictedCollision]:
     t0 = motion.t_start if t_from is None else float(t_from)
     t1 = motion.t_end if t_until is None else float(t_until)
+    key = (float(robot_radius), t0, t1, float(margin), float(tol), sample_dt, first_only)
+    obs = tuple(obstacles)
+    for m, o, k, hits in _MEMO:
+        if m is motion and k == key and len(o) == len(obs) and all(
+                a is b for a, b in zip(o, obs, strict=True)):
+            return list(hits)
+    out = _predict_uncached(motion, obs, float(robot_radius), t0, t1, margin, tol, sample_dt,
+                            first_only)
+    _MEMO.append((motion, obs, key, list(out)))
+    del _MEMO[:-_MEMO_SIZE]
+    return out
+
+
+def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle],
+                      robot_radius: float, t0: float, t1: float, margin: float, tol: float,
+                      sample_dt: float | None, first_only: bool) -> list[PredictedCollision]:
     out: list[PredictedCollision] = []
     if t1 < t0 or not obstacles:
         return out
