@@ -129,5 +129,5 @@ def test_regular_polygon_inscribed_and_circumscribed():
 @pytest.mark.parametrize("pts", [[[0, 0], [1, 1]], [[0, 0], [1, 0], [2, 0]],
                                  [[0, 0], [2, 2], [2, 0], [0, 2]]])
 def test_bad_polygons_are_rejected(pts):
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="polygon"):
         Polygon(np.array(pts, float))

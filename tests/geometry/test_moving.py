@@ -26,7 +26,7 @@ def test_straight_first_contact_matches_sampling(px, py, ux, uy, qx, qy, wx, wy,
     d = np.hypot(*((p + np.outer(t, u)) - (q + np.outer(t, w))).T)
     hit = np.nonzero(d <= R)[0]
     tc = first_contact_straight(p, u, q, w, R, 0.0, 5.0)
-    tm, dm = closest_approach_straight(p, u, q, w, 0.0, 5.0)
+    _tm, dm = closest_approach_straight(p, u, q, w, 0.0, 5.0)
     assert dm <= d.min() + 1e-9
     assert abs(dm - d.min()) <= np.hypot(*(u - w)) * 1e-4 + 1e-9
     if len(hit):
@@ -65,7 +65,7 @@ def test_certified_first_contact_circular_never_late(x0, y0, th, v, om, px, py, 
             # A conservative early answer: only when the distance grazes the contact distance
             # for long (the evaluation budget of a near-plateau ran out).
             assert d[t >= tc].min() - R < 20.0 * L * 8 / MAX_EVALUATIONS + 1e-3
-    tm, dm = closest_approach(robot, m.positions, L, 0.0, 20.0, tol=1e-6)
+    _tm, dm = closest_approach(robot, m.positions, L, 0.0, 20.0, tol=1e-6)
     # Certified to within L * tol of the true minimum, which sampling can only overestimate.
     assert dm <= d.min() + L * 1e-6 + 1e-9
     assert dm >= d.min() - L * 1e-4 - 1e-9

@@ -31,7 +31,7 @@ def _as_polygons(boxes: np.ndarray) -> list[Polygon]:
 @pytest.mark.parametrize("seed", range(6))
 @pytest.mark.parametrize("radius", [0.0, 0.1])
 def test_map_visgraph_equals_polygon_visgraph(seed, radius):
-    occ, boxes = _random_map(seed)
+    _occ, boxes = _random_map(seed)
     bounds = (0.0, 0.0, 5.0, 4.0)
     start, goal = (0.25, 0.25), (4.75, 3.75)
     as_map = Problem.create(ObstacleSet([], bounds=bounds, boxes=boxes), start, goal, radius)
@@ -50,7 +50,7 @@ def test_map_visgraph_equals_polygon_visgraph(seed, radius):
 
 
 def test_lower_bound_is_below_the_feasible_path_on_a_map():
-    occ, boxes = _random_map(12, 30, 40, 0.08, 0.2)
+    _occ, boxes = _random_map(12, 30, 40, 0.08, 0.2)
     obs = ObstacleSet([], bounds=(0.0, 0.0, 8.0, 6.0), boxes=boxes)
     prob = Problem.create(obs, (0.2, 0.2), (7.8, 5.8), 0.15)
     lo = shortest_path(prob, variant="lower", arc_step=math.pi / 8)

@@ -39,9 +39,12 @@ def closest_approach_straight(p: np.ndarray, u: np.ndarray, q: np.ndarray, w: np
     """Closest approach of ``p + u t`` and ``q + w t`` for t in [t0, t1].
 
     Args:
-        p, q: Positions at t = 0 [m], shape (2,).
-        u, w: Constant velocities [m/s], shape (2,).
-        t0, t1: Interval [s], t0 <= t1.
+        p: First position at t = 0 [m], shape (2,).
+        u: First constant velocity [m/s], shape (2,).
+        q: Second position at t = 0 [m], shape (2,).
+        w: Second constant velocity [m/s], shape (2,).
+        t0: Interval start [s].
+        t1: Interval end [s], t1 >= t0.
 
     Returns:
         (time [s], distance [m]) of the minimum distance on the interval.
@@ -74,7 +77,7 @@ def first_contact_straight(p: np.ndarray, u: np.ndarray, q: np.ndarray, w: np.nd
     sq = math.sqrt(disc)
     # Numerically stable smaller root.
     qv = -0.5 * (b + math.copysign(sq, b)) if b != 0.0 else -0.5 * sq
-    r1, r2 = sorted((qv / a, c / qv if qv != 0.0 else qv / a))
+    r1, _r2 = sorted((qv / a, c / qv if qv != 0.0 else qv / a))
     if r1 >= t0 and r1 <= t1:
         return r1
     return None
@@ -127,11 +130,13 @@ def first_contact(pos_a: PositionFn, pos_b: PositionFn, rel_speed_bound: float, 
     """First time in [t0, t1] at which two moving points come within ``radius``, or None.
 
     Args:
-        pos_a, pos_b: Position functions, times (N,) [s] -> positions (N, 2) [m].
+        pos_a: Position function, times (N,) [s] -> positions (N, 2) [m].
+        pos_b: The other one, likewise.
         rel_speed_bound: An upper bound on |d/dt (pos_a - pos_b)| [m/s] over the interval
             (e.g. the sum of both maximum speeds).
         radius: Contact distance [m] (sum of the disc radii).
-        t0, t1: Interval [s].
+        t0: Interval start [s].
+        t1: Interval end [s].
         tol: Time accuracy [s]. A grazing approach that cannot be told from a contact at
             this accuracy is reported as a contact (conservative).
 

@@ -13,6 +13,7 @@ Examples:
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -20,7 +21,7 @@ import numpy as np
 __all__ = ["Circle", "Polygon", "Shape", "rectangle", "square", "regular_polygon"]
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class Circle:
     """A disc.
 
@@ -32,11 +33,11 @@ class Circle:
     center: np.ndarray
     radius: float
 
-    def __post_init__(self) -> None:
-        c = np.asarray(self.center, dtype=float).reshape(2)
+    def __init__(self, center: Sequence[float] | np.ndarray, radius: float) -> None:
+        c = np.asarray(center, dtype=float).reshape(2)
         c.setflags(write=False)
         object.__setattr__(self, "center", c)
-        object.__setattr__(self, "radius", float(self.radius))
+        object.__setattr__(self, "radius", float(radius))
         if not self.radius > 0.0:
             raise ValueError(f"radius must be > 0, got {self.radius}")
 
@@ -144,7 +145,7 @@ def _segments_cross(p1: np.ndarray, p2: np.ndarray, q1: np.ndarray, q2: np.ndarr
     return (d1 * d2 < 0.0) and (d3 * d4 < 0.0)
 
 
-def rectangle(center: tuple[float, float] | np.ndarray, size: tuple[float, float] | np.ndarray,
+def rectangle(center: Sequence[float] | np.ndarray, size: Sequence[float] | np.ndarray,
               angle: float = 0.0) -> Polygon:
     """Rectangle of ``size`` (width [m], height [m]) centred at ``center``, rotated by ``angle`` [rad]."""
     w, h = (float(s) for s in size)
@@ -156,7 +157,7 @@ def rectangle(center: tuple[float, float] | np.ndarray, size: tuple[float, float
     return Polygon(local @ rot.T + np.asarray(center, dtype=float).reshape(2))
 
 
-def square(center: tuple[float, float] | np.ndarray, side: float) -> Polygon:
+def square(center: Sequence[float] | np.ndarray, side: float) -> Polygon:
     """Axis-aligned square of side ``side`` [m] centred at ``center``."""
     return rectangle(center, (side, side), 0.0)
 

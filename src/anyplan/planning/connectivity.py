@@ -31,6 +31,8 @@ def provably_disconnected(obstacles: ObstacleSet, start: np.ndarray | tuple[floa
 
     Args:
         obstacles: The static obstacles; their ``bounds`` (the arena) are required.
+        start: Start position (x, y) [m].
+        goal: Goal position (x, y) [m].
         radius: Robot radius [m], > 0.
         cell: Cell side [m]; default max(radius / 2, the side giving :data:`MAX_CELLS` cells).
     """

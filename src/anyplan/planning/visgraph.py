@@ -1,30 +1,14 @@
 """Exact shortest paths for a disc robot among polygons and circles, by a visibility graph.
 
-The configuration-space obstacles are the obstacles inflated by the robot radius ``r``
-(Minkowski sum with a disc), which have round corners. Their arcs are replaced by polygonal
-chains with a step of at most ``arc_step`` [rad]:
-
-* ``variant="lower"``: chains *inscribed* in the arcs. The relaxed obstacles are subsets of the
-  true ones, so the exact shortest path among them is a **lower bound** on the optimum (to a
-  tolerance of ~1e-9 m per contact).
-* ``variant="feasible"``: chains *circumscribed* about the arcs, and every graph edge checked with
-  the exact disc-robot segment test of :class:`~anyplan.geometry.collision.ObstacleSet`. The
-  returned path passes the exact check; its length is an upper bound on the optimum, within a
-  relative ~``arc_step**2 / 8`` of it.
-
-The shortest path among polygonal obstacles bends only at convex obstacle vertices, and each of
-its edges is tangent to the obstacles at both ends (Lozano-Pérez & Wesley, CACM 1979; the
-"reduced" or tangent visibility graph, e.g. de Berg et al., *Computational Geometry*, ch. 15).
-We enumerate vertex pairs, keep the bitangent ones, test visibility exactly and run Dijkstra.
-
-Arena walls: the robot centre must stay in the bounds shrunk by ``r``. Obstacles touching or
-crossing a wall are *not* clipped: the free space is the shrunk box minus the full inflated
-obstacles, so a gap between an obstacle and a wall narrower than ``2 r`` is closed, and no path
-squeezes along the border (the pitfall of ``shared/research/peers.md`` §5.3). Corners where an
-obstacle meets a wall are concave for the free space, so paths never bend there.
-
-Non-convex polygons are handled through their Minkowski sum, the union of the polygon (split
-into triangles by ear clipping), one rectangle per edge and one disc sector per convex vertex.
+The tangent (reduced) visibility graph of the obstacles inflated by the robot radius ``r``
+(Lozano-Pérez & Wesley, CACM 1979; de Berg et al., *Computational Geometry*, ch. 15), searched
+by Dijkstra; the inflated obstacles' round corners become chains of chords with a step of at
+most ``arc_step`` [rad]. ``variant="lower"`` inscribes the chains (a **lower bound** on the
+optimum, to ~1e-9 m per contact); ``variant="feasible"`` circumscribes them and checks every
+edge exactly with :class:`~anyplan.geometry.collision.ObstacleSet` (a valid path, within a
+relative ~``arc_step**2 / 8`` of the optimum). The robot centre stays in the bounds shrunk by
+``r``; obstacles are not clipped at the walls. Convex components for the interior tests travel
+as one record, :class:`Components`. Details: ``docs/planning.md`` ("Exact optimum").
 """
 
 from __future__ import annotations
@@ -32,6 +16,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -227,11 +212,32 @@ def _radius(problem: Problem, variant: str) -> float:
     return problem.check_radius if variant == "feasible" else problem.radius
 
 
-def _pack(comps: list[np.ndarray]) -> tuple[np.ndarray, ...]:
-    """Flat arrays of convex components: vertices, starts, boxes, edge normals and offsets."""
+class Components(NamedTuple):
+    """Convex polygons whose union is the (relaxed) inflated obstacles, for the interior
+    tests; K components, E edges in all. Produced by :func:`_pack` only."""
+
+    #: Vertex x [m], shape (E,).
+    vx: np.ndarray
+    #: Vertex y [m], shape (E,).
+    vy: np.ndarray
+    #: int64 offsets, shape (K + 1,): component k owns vertices and edges
+    #: ``starts[k]:starts[k + 1]``.
+    starts: np.ndarray
+    #: Bounding boxes (xmin, ymin, xmax, ymax) [m], shape (K, 4).
+    box: np.ndarray
+    #: Outward unit normal x of each edge, shape (E,).
+    nx: np.ndarray
+    #: Outward unit normal y of each edge, shape (E,).
+    ny: np.ndarray
+    #: Offset of each edge's line, ``nx * x + ny * y = off`` [m], shape (E,).
+    off: np.ndarray
+
+
+def _pack(comps: list[np.ndarray]) -> Components:
+    """The record of the convex components ``comps`` (CCW vertex arrays)."""
     if not comps:
         z = np.zeros(0)
-        return z, z, np.zeros(1, np.int64), np.zeros((0, 4)), z, z, z
+        return Components(z, z, np.zeros(1, np.int64), np.zeros((0, 4)), z, z, z)
     verts = np.vstack(comps)
     starts = np.concatenate([[0], np.cumsum([len(c) for c in comps])]).astype(np.int64)
     box = np.array([[c[:, 0].min(), c[:, 1].min(), c[:, 0].max(), c[:, 1].max()] for c in comps])
@@ -244,16 +250,21 @@ def _pack(comps: list[np.ndarray]) -> tuple[np.ndarray, ...]:
         nx.append(ux)
         ny.append(uy)
         off.append(ux * c[:, 0] + uy * c[:, 1])
-    return (np.ascontiguousarray(verts[:, 0]), np.ascontiguousarray(verts[:, 1]), starts, box,
-            np.concatenate(nx), np.concatenate(ny), np.concatenate(off))
+    return Components(np.ascontiguousarray(verts[:, 0]), np.ascontiguousarray(verts[:, 1]),
+                      starts, box, np.concatenate(nx), np.concatenate(ny), np.concatenate(off))
 
 
 # ------------------------------------------------------------------------------------------
 # Compiled kernels
 # ------------------------------------------------------------------------------------------
 @njit(cache=True)
-def _point_in_any(px: float, py: float, starts: np.ndarray, box: np.ndarray, nx: np.ndarray,
-                  ny: np.ndarray, off: np.ndarray, eps: float) -> bool:
+def _point_in_any(px: float, py: float, c: Components, eps: float) -> bool:
+    """True if p is in the open interior (shrunk by eps) of any convex component."""
+    starts = c.starts
+    box = c.box
+    nx = c.nx
+    ny = c.ny
+    off = c.off
     for k in range(starts.shape[0] - 1):
         if px <= box[k, 0] or px >= box[k, 2] or py <= box[k, 1] or py >= box[k, 3]:
             continue
@@ -268,10 +279,23 @@ def _point_in_any(px: float, py: float, starts: np.ndarray, box: np.ndarray, nx:
 
 
 @njit(cache=True)
-def _segment_hits_any(ax: float, ay: float, bx: float, by: float, starts: np.ndarray,
-                      box: np.ndarray, nx: np.ndarray, ny: np.ndarray, off: np.ndarray,
+def _points_in_any(px: np.ndarray, py: np.ndarray, c: Components, eps: float) -> np.ndarray:
+    """Mask (N,): :func:`_point_in_any` of each point."""
+    out = np.zeros(px.shape[0], np.bool_)
+    for i in range(px.shape[0]):
+        out[i] = _point_in_any(px[i], py[i], c, eps)
+    return out
+
+
+@njit(cache=True)
+def _segment_hits_any(ax: float, ay: float, bx: float, by: float, c: Components,
                       eps: float) -> bool:
     """True if segment ab meets the open interior (shrunk by eps) of any convex component."""
+    starts = c.starts
+    box = c.box
+    nx = c.nx
+    ny = c.ny
+    off = c.off
     x0 = min(ax, bx)
     x1 = max(ax, bx)
     y0 = min(ay, by)
@@ -315,8 +339,7 @@ def _tangent(ux: float, uy: float, px: float, py: float, qx: float, qy: float, v
 
 @njit(cache=True)
 def _edges(px: np.ndarray, py: np.ndarray, prv: np.ndarray, nxt: np.ndarray, n_free: int,
-           exact: bool, radius: float, starts: np.ndarray, box: np.ndarray, nx: np.ndarray,
-           ny: np.ndarray, off: np.ndarray, obs: ObstacleArrays,
+           exact: bool, radius: float, comps: Components, obs: ObstacleArrays,
            box_limit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Visible bitangent edges; nodes ``[0, n_free)`` (start, goal) skip the tangent test.
 
@@ -341,8 +364,7 @@ def _edges(px: np.ndarray, py: np.ndarray, prv: np.ndarray, nxt: np.ndarray, n_f
                 if segment_blocked_kernel(px[i], py[i], px[j], py[j], obs, limit):
                     continue
             else:
-                if _segment_hits_any(px[i], py[i], px[j], py[j], starts, box, nx, ny, off,
-                                     1e-9):
+                if _segment_hits_any(px[i], py[i], px[j], py[j], comps, 1e-9):
                     continue
                 if box_limit > 0.0 and segment_blocked_kernel(px[i], py[i], px[j], py[j], obs,
                                                               box_limit):
@@ -401,7 +423,7 @@ def shortest_path(problem: Problem, *, variant: str = "feasible",
         return done(PlannerStatus.INVALID_GOAL, empty, math.inf, 0, 0)
 
     b = _build(problem, variant, arc_step)
-    xs, ys, starts, box, nx, ny, off = _pack(b.comps)
+    comps = _pack(b.comps)
     r = _radius(problem, variant)
     # Lower variant on a map: the inscribed chains of the boxes' inflated corners contain the
     # boxes inflated by the chords' distance, so clearance >= that distance is a relaxation.
@@ -422,9 +444,9 @@ def shortest_path(problem: Problem, *, variant: str = "feasible",
         else:
             if box_limit > 0.0:
                 keep &= _box_set(problem).clearances(nodes) >= box_limit
-            for i in np.flatnonzero(keep):
-                if _point_in_any(nodes[i, 0], nodes[i, 1], starts, box, nx, ny, off, _EPS):
-                    keep[i] = False
+            idx = np.flatnonzero(keep)
+            keep[idx[_points_in_any(np.ascontiguousarray(nodes[idx, 0]),
+                                    np.ascontiguousarray(nodes[idx, 1]), comps, _EPS)]] = False
         nodes, prv, nxt = nodes[keep], prv[keep], nxt[keep]
     else:
         nodes = prv = nxt = np.zeros((0, 2))
@@ -436,7 +458,7 @@ def shortest_path(problem: Problem, *, variant: str = "feasible",
     exact = variant == "feasible"
     oarr = problem.obstacles.arrays if exact or box_limit <= 0.0 else _box_set(problem).arrays
     ei, ej, w = _edges(np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), prv, nxt,
-                       2, exact, problem.check_radius, starts, box, nx, ny, off, oarr, box_limit)
+                       2, exact, problem.check_radius, comps, oarr, box_limit)
     from scipy.sparse import coo_matrix  # lazy: keeps `import anyplan.planning` light
     from scipy.sparse.csgraph import dijkstra
 

@@ -36,10 +36,6 @@ class Points(NamedTuple):
     batch: np.ndarray
     #: Number of points in use, int64, shape (1,).
     n: np.ndarray
-    #: Scratch: the points found by a neighbour query, int64, shape (C,).
-    near: np.ndarray
-    #: Scratch: their distances [m], shape (C,).
-    near_d: np.ndarray
 
 
 class Batch(NamedTuple):
@@ -77,8 +73,7 @@ class Batch(NamedTuple):
 def new_points(cap: int, start: np.ndarray, goal: np.ndarray) -> Points:
     """Room for ``cap`` points, holding the start (0) and the goal (1)."""
     p = Points(np.zeros((cap, 2)), np.full(cap, math.inf), np.full(cap, math.inf),
-               np.full(cap, -1, np.int64), np.array([2], np.int64), np.zeros(cap, np.int64),
-               np.zeros(cap))
+               np.full(cap, -1, np.int64), np.array([2], np.int64))
     for i, x in enumerate((start, goal)):
         p.xy[i] = x
         p.g_hat[i] = np.hypot(*(x - start))
@@ -95,8 +90,7 @@ def with_capacity(p: Points, cap: int) -> Points:
     return Points(np.vstack([p.xy, np.zeros((extra, 2))]),
                   np.concatenate([p.g_hat, np.full(extra, math.inf)]),
                   np.concatenate([p.h_hat, np.full(extra, math.inf)]),
-                  np.concatenate([p.batch, np.full(extra, -1, np.int64)]), p.n,
-                  np.zeros(cap, np.int64), np.zeros(cap))
+                  np.concatenate([p.batch, np.full(extra, -1, np.int64)]), p.n)
 
 
 def append_samples(p: Points, pts: np.ndarray, start: np.ndarray, goal: np.ndarray,
@@ -245,13 +239,12 @@ def build_grid(xy: np.ndarray, idx: np.ndarray, x0: float, y0: float, cell: floa
 
 
 @njit(cache=True)
-def near(v: int, p: Points, b: Batch, rad: float, cstart: np.ndarray,
-         citems: np.ndarray) -> int:
+def near(v: int, p: Points, b: Batch, rad: float, cstart: np.ndarray, citems: np.ndarray,
+         out: np.ndarray, dout: np.ndarray) -> int:
     """Points of the grid (cstart, citems) within ``rad`` of point v (v excluded) into
-    ``p.near``/``p.near_d``; returns their number. ``rad`` must not exceed ``b.cell``."""
+    ``out`` (ids) and ``dout`` (distances [m]), scratch of at least ``p.n[0]`` slots; returns
+    their number. ``rad`` must not exceed ``b.cell``."""
     xy = p.xy
-    out = p.near
-    dout = p.near_d
     ncx = b.ncx
     ncy = b.ncy
     px = xy[v, 0]
@@ -277,16 +270,14 @@ def near(v: int, p: Points, b: Batch, rad: float, cstart: np.ndarray,
 
 
 @njit(cache=True)
-def k_nearest(v: int, p: Points, b: Batch) -> int:
-    """The ``b.k`` nearest points to v (v excluded) into ``p.near``/``p.near_d``, nearest
-    first, searching grid rings outwards; returns their number.
+def k_nearest(v: int, p: Points, b: Batch, out: np.ndarray, dout: np.ndarray) -> int:
+    """The ``b.k`` nearest points to v (v excluded) into ``out``/``dout`` (as :func:`near`),
+    nearest first, searching grid rings outwards; returns their number.
 
     Points outside the (2 ring + 1)^2 block of cells around v's cell are farther than
     ``ring * cell``, so the search stops once k candidates lie within that distance.
     """
     xy = p.xy
-    out = p.near
-    dout = p.near_d
     cstart = b.start
     citems = b.items
     cell = b.cell
@@ -342,7 +333,7 @@ def compact(p: Points, t: Tree, state: np.ndarray, next_batch_number: int) -> np
 
 
 @njit(cache=True)
-def _compact(p_fields: tuple, t_fields: tuple, state: np.ndarray,  # type: ignore[type-arg]
+def _compact(p_fields: tuple, t_fields: tuple, state: np.ndarray,
              next_batch_number: int) -> np.ndarray:
     """Drop, recycle and keep points, keeping the tree consistent.
 

@@ -63,7 +63,7 @@ def with_vertex_room(q: SearchQueue, n_points: int) -> SearchQueue:
     return SearchQueue(np.zeros(size), np.zeros(size, np.int64), q.ekey, q.edge, q.nv, q.ne)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def push_vertex(q: SearchQueue, key: float, v: int) -> None:
     """Queue vertex v with ``key`` (the capacity must suffice)."""
     keys = q.vkey
@@ -81,7 +81,7 @@ def push_vertex(q: SearchQueue, key: float, v: int) -> None:
     q.nv[0] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def pop_vertex(q: SearchQueue) -> None:
     """Remove the top of the vertex queue."""
     keys = q.vkey
@@ -109,7 +109,7 @@ def pop_vertex(q: SearchQueue) -> None:
     q.nv[0] = size
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def push_edge(q: SearchQueue, key: float, v: int, x: int) -> None:
     """Queue edge (v, x) with ``key`` (the capacity must suffice)."""
     keys = q.ekey
@@ -129,7 +129,7 @@ def push_edge(q: SearchQueue, key: float, v: int, x: int) -> None:
     q.ne[0] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def pop_edge(q: SearchQueue) -> None:
     """Remove the top of the edge queue."""
     keys = q.ekey

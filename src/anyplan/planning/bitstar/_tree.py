@@ -37,15 +37,13 @@ class Tree(NamedTuple):
     old: np.ndarray
     #: Batch in which the vertex was last expanded (-1: to be expanded), int64, shape (C,).
     expanded: np.ndarray
-    #: Scratch stack for walks over subtrees, int64, shape (C,).
-    stack: np.ndarray
 
 
 def new_tree(cap: int) -> Tree:
     """A tree holding only the root (point 0, the start, at cost 0)."""
     t = Tree(np.full(cap, math.inf), np.full(cap, -1, np.int64), np.full(cap, -1, np.int64),
              np.full(cap, -1, np.int64), np.full(cap, -1, np.int64), np.zeros(cap, np.bool_),
-             np.zeros(cap, np.bool_), np.full(cap, -1, np.int64), np.zeros(cap, np.int64))
+             np.zeros(cap, np.bool_), np.full(cap, -1, np.int64))
     t.g[0] = 0.0
     t.vertex[0] = True
     return t
@@ -62,7 +60,7 @@ def with_capacity(t: Tree, cap: int) -> Tree:
 
     return Tree(more(t.g, math.inf), more(t.parent, -1), more(t.child, -1),
                 more(t.next_sibling, -1), more(t.prev_sibling, -1), more(t.vertex, False),
-                more(t.old, False), more(t.expanded, -1), np.zeros(cap, np.int64))
+                more(t.old, False), more(t.expanded, -1))
 
 
 def reset(t: Tree, lo: int, hi: int) -> None:
@@ -129,9 +127,9 @@ def attach(t: Tree, x: int, p: int) -> None:
 
 
 @njit(cache=True)
-def shift_subtree(t: Tree, root: int, delta: float) -> None:
-    """Subtract ``delta`` from g_T of every strict descendant of ``root``."""
-    stack = t.stack
+def shift_subtree(t: Tree, root: int, delta: float, stack: np.ndarray) -> None:
+    """Subtract ``delta`` from g_T of every strict descendant of ``root`` (``stack``: scratch
+    of at least as many slots as vertices)."""
     top = 0
     c = t.child[root]
     while c >= 0:
@@ -155,7 +153,7 @@ def surviving_vertices(t: Tree, n: int, state: np.ndarray) -> np.ndarray:
     the root always survives."""
     keepv = np.zeros(n, np.bool_)
     keepv[0] = True
-    stack = t.stack
+    stack = np.empty(n, np.int64)
     top = 0
     c = t.child[0]
     while c >= 0:

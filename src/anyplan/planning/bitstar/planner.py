@@ -156,7 +156,7 @@ class BITStar(Planner):
     @property
     def best_cost(self) -> float:
         """Cost [m] of the best solution so far (inf if none)."""
-        return float(self._progress.best[0])
+        return float(self._progress[0]["best"])
 
     @property
     def n_batches(self) -> int:
@@ -168,15 +168,15 @@ class BITStar(Planner):
         """Counters: points, vertices, batches, edge checks, ..."""
         n = int(self._points.n[0])
         nv = int(np.count_nonzero(self._tree.vertex[:n]))
-        pr = self._progress
+        pr = self._progress[0]
         return {
             "n_points": n, "n_vertices": nv, "n_samples": n - nv,
             "n_samples_drawn": self._n_samples_drawn, "n_batches": self.n_batches,
-            "n_edge_checks": int(pr.edge_checks[0]),
-            "n_edge_checks_failed": int(pr.edge_checks_failed[0]),
-            "n_expansions": int(pr.expansions[0]), "n_rewirings": int(pr.rewirings[0]),
-            "n_iterations": int(pr.edges_popped[0]),
-            "n_edges_queued": int(pr.edges_queued[0]),
+            "n_edge_checks": int(pr["edge_checks"]),
+            "n_edge_checks_failed": int(pr["edge_checks_failed"]),
+            "n_expansions": int(pr["expansions"]), "n_rewirings": int(pr["rewirings"]),
+            "n_iterations": int(pr["edges_popped"]),
+            "n_edges_queued": int(pr["edges_queued"]),
             "radius_m": float(self._batch.radius),
         }
 
@@ -301,8 +301,8 @@ class BITStar(Planner):
         if not p.obstacles.segment_free(p.start, p.goal, p.check_radius):
             return
         _tree.attach_root_child(self._tree, 1, self._c_min)
-        self._progress.edge_checks[0] += 1
-        self._progress.best[0] = self._c_min
+        self._progress[0]["edge_checks"] += 1
+        self._progress[0]["best"] = self._c_min
         t = time.perf_counter() + clock_base
         self._first_time = t
         self._history.append((t, self._c_min))
@@ -342,7 +342,7 @@ class BITStar(Planner):
         _graph.compact(p, t, state, self.n_batches + 1)
         old_cost = self.best_cost
         g_goal = float(t.g[1])
-        self._progress.best[0] = g_goal
+        self._progress[0]["best"] = g_goal
         if g_goal > old_cost or not math.isfinite(g_goal):
             self._pruned_cost = math.inf
         self._path = self._extract_path()
