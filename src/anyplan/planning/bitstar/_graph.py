@@ -238,7 +238,7 @@ def build_grid(xy: np.ndarray, idx: np.ndarray, x0: float, y0: float, cell: floa
     return cstart, citems
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def near(v: int, p: Points, b: Batch, rad: float, cstart: np.ndarray, citems: np.ndarray,
          out: np.ndarray, dout: np.ndarray) -> int:
     """Points of the grid (cstart, citems) within ``rad`` of point v (v excluded) into

@@ -63,12 +63,14 @@ def with_vertex_room(q: SearchQueue, n_points: int) -> SearchQueue:
     return SearchQueue(np.zeros(size), np.zeros(size, np.int64), q.ekey, q.edge, q.nv, q.ne)
 
 
-@njit(cache=True, inline="always")
-def push_vertex(q: SearchQueue, key: float, v: int) -> None:
-    """Queue vertex v with ``key`` (the capacity must suffice)."""
-    keys = q.vkey
-    pay = q.vertex
-    i = q.nv[0]
+# The heap primitives take the arrays themselves (hoisted by the caller): reading a record's
+# field in compiled code takes a reference (an atomic increment and decrement), too costly per
+# push and pop.
+@njit(cache=True)
+def push_vertex(keys: np.ndarray, pay: np.ndarray, size: int, key: float, v: int) -> int:
+    """Push vertex v with ``key`` on the vertex heap (``vkey``, ``vertex``) of ``size``
+    entries; returns the new size (the capacity must suffice)."""
+    i = size
     while i > 0:
         p = (i - 1) >> 1
         if keys[p] <= key:
@@ -78,18 +80,15 @@ def push_vertex(q: SearchQueue, key: float, v: int) -> None:
         i = p
     keys[i] = key
     pay[i] = v
-    q.nv[0] += 1
+    return size + 1
 
 
-@njit(cache=True, inline="always")
-def pop_vertex(q: SearchQueue) -> None:
-    """Remove the top of the vertex queue."""
-    keys = q.vkey
-    pay = q.vertex
-    size = q.nv[0] - 1
+@njit(cache=True)
+def pop_vertex(keys: np.ndarray, pay: np.ndarray, size: int) -> int:
+    """Remove the top of the vertex heap of ``size`` entries; returns the new size."""
+    size -= 1
     if size <= 0:
-        q.nv[0] = 0
-        return
+        return 0
     key = keys[size]
     a = pay[size]
     i = 0
@@ -106,15 +105,14 @@ def pop_vertex(q: SearchQueue) -> None:
         i = c
     keys[i] = key
     pay[i] = a
-    q.nv[0] = size
+    return size
 
 
-@njit(cache=True, inline="always")
-def push_edge(q: SearchQueue, key: float, v: int, x: int) -> None:
-    """Queue edge (v, x) with ``key`` (the capacity must suffice)."""
-    keys = q.ekey
-    pay = q.edge
-    i = q.ne[0]
+@njit(cache=True)
+def push_edge(keys: np.ndarray, pay: np.ndarray, size: int, key: float, v: int, x: int) -> int:
+    """Push edge (v, x) with ``key`` on the edge heap (``ekey``, ``edge``) of ``size``
+    entries; returns the new size (the capacity must suffice)."""
+    i = size
     while i > 0:
         p = (i - 1) >> 1
         if keys[p] <= key:
@@ -126,18 +124,15 @@ def push_edge(q: SearchQueue, key: float, v: int, x: int) -> None:
     keys[i] = key
     pay[i, 0] = v
     pay[i, 1] = x
-    q.ne[0] += 1
+    return size + 1
 
 
-@njit(cache=True, inline="always")
-def pop_edge(q: SearchQueue) -> None:
-    """Remove the top of the edge queue."""
-    keys = q.ekey
-    pay = q.edge
-    size = q.ne[0] - 1
+@njit(cache=True)
+def pop_edge(keys: np.ndarray, pay: np.ndarray, size: int) -> int:
+    """Remove the top of the edge heap of ``size`` entries; returns the new size."""
+    size -= 1
     if size <= 0:
-        q.ne[0] = 0
-        return
+        return 0
     key = keys[size]
     a = pay[size, 0]
     b = pay[size, 1]
@@ -157,4 +152,4 @@ def pop_edge(q: SearchQueue) -> None:
     keys[i] = key
     pay[i, 0] = a
     pay[i, 1] = b
-    q.ne[0] = size
+    return size

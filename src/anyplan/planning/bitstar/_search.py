@@ -71,7 +71,7 @@ def _begin_batch(p: tuple, t: tuple, q: tuple, b: tuple, pr: np.ndarray) -> None
     start_batch(Points(*p), Tree(*t), SearchQueue(*q), Batch(*b), pr)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _expand(v: int, p: Points, t: Tree, q: SearchQueue, b: Batch, pr: np.ndarray,
             near: np.ndarray, near_d: np.ndarray) -> None:
     """ExpandVertex(v): queue the edges from v that could improve the solution.
@@ -93,28 +93,38 @@ def _expand(v: int, p: Points, t: Tree, q: SearchQueue, b: Batch, pr: np.ndarray
     else:
         m = _graph.near(v, p, b, b.radius, b.start, b.items, near, near_d)
     c_best = st.best
-    gv = t.g[v]
+    # the fields as locals in the loop (one reference each, not one per access)
+    g = t.g
+    parent = t.parent
+    vertex = t.vertex
+    h_hat = p.h_hat
+    sbatch = p.batch
+    ekey = q.ekey
+    edge = q.edge
+    es = q.ne[0]
+    gv = g[v]
     ghv = p.g_hat[v]
     for i in range(m):
         x = near[i]
         d = near_d[i]
-        if not t.vertex[x]:
-            if seen_before and not is_new and p.batch[x] != batch:
+        if not vertex[x]:
+            if seen_before and not is_new and sbatch[x] != batch:
                 continue
             # g_hat(v) + c_hat(v, x) + h_hat(x) < c_best ?
-            if ghv + d + p.h_hat[x] < c_best:
-                _queue.push_edge(q, gv + d + p.h_hat[x], v, x)
+            if ghv + d + h_hat[x] < c_best:
+                es = _queue.push_edge(ekey, edge, es, gv + d + h_hat[x], v, x)
                 st.edges_queued += 1
         # Rewiring candidate (new vertices only): g_hat(v) + c_hat(v, x) + h_hat(x) < c_best
         # and g_T(v) + c_hat(v, x) < g_T(x) ?
-        elif (is_new and x != t.parent[v] and t.parent[x] != v
-              and ghv + d + p.h_hat[x] < c_best and gv + d < t.g[x]):
-            _queue.push_edge(q, gv + d + p.h_hat[x], v, x)
+        elif (is_new and x != parent[v] and parent[x] != v
+              and ghv + d + h_hat[x] < c_best and gv + d < g[x]):
+            es = _queue.push_edge(ekey, edge, es, gv + d + h_hat[x], v, x)
             st.edges_queued += 1
-    if v == 0 and not t.vertex[1] and p.g_hat[1] > b.radius:
+    if v == 0 and not vertex[1] and p.g_hat[1] > b.radius:
         # Always try the direct start-goal edge, the best possible one, even beyond r.
-        _queue.push_edge(q, p.g_hat[1], np.int64(0), np.int64(1))
+        es = _queue.push_edge(ekey, edge, es, p.g_hat[1], np.int64(0), np.int64(1))
         st.edges_queued += 1
+    q.ne[0] = es
 
 
 @njit(cache=True)
@@ -132,74 +142,87 @@ def iterate(p: Points, t: Tree, q: SearchQueue, b: Batch, pr: np.ndarray, obs: O
     near = np.empty(n, np.int64)  # scratch of the neighbour queries and subtree walks
     near_d = np.empty(n)
     stack = np.empty(n, np.int64)
+    xy = p.xy
+    h_hat = p.h_hat
+    g = t.g
+    parent = t.parent
+    vertex = t.vertex
+    expanded = t.expanded
+    vkey = q.vkey
+    vqueue = q.vertex
+    ekey = q.ekey
+    edge = q.edge
+    nv = q.nv
+    ne = q.ne
+    batch = b.number
     work = 0  # edge pops + vertex expansions, bounded by max_iter per call
     while work < max_iter:
-        if q.ekey.shape[0] - q.ne[0] < n + 8 or q.vkey.shape[0] - q.nv[0] < 8:
+        if ekey.shape[0] - ne[0] < n + 8 or vkey.shape[0] - nv[0] < 8:
             return GROW
         work += 1
         c_best = st.best
         # Expand vertices while the best vertex key <= the best edge key.
-        while q.nv[0] > 0:
+        while nv[0] > 0:
             if work >= max_iter:
                 return BUDGET
-            v = q.vertex[0]
-            kv = q.vkey[0]
-            if t.expanded[v] == b.number or not t.vertex[v]:
-                _queue.pop_vertex(q)
+            v = vqueue[0]
+            kv = vkey[0]
+            if expanded[v] == batch or not vertex[v]:
+                nv[0] = _queue.pop_vertex(vkey, vqueue, nv[0])
                 continue
-            if q.ne[0] > 0 and kv > q.ekey[0]:
+            if ne[0] > 0 and kv > ekey[0]:
                 break
             if kv >= c_best:
                 break
-            _queue.pop_vertex(q)
+            nv[0] = _queue.pop_vertex(vkey, vqueue, nv[0])
             _expand(v, p, t, q, b, pr, near, near_d)
             work += 1
-            if q.ekey.shape[0] - q.ne[0] < n + 8:
+            if ekey.shape[0] - ne[0] < n + 8:
                 return GROW
-        if q.ne[0] == 0:
+        if ne[0] == 0:
             return BATCH_DONE
-        if q.ekey[0] >= c_best:
+        if ekey[0] >= c_best:
             # Every queued edge is (as far as the keys know) useless: the batch is done.
-            q.ne[0] = 0
-            q.nv[0] = 0
+            ne[0] = 0
+            nv[0] = 0
             return BATCH_DONE
-        a = q.edge[0, 0]
-        x = q.edge[0, 1]
-        _queue.pop_edge(q)
+        a = edge[0, 0]
+        x = edge[0, 1]
+        ne[0] = _queue.pop_edge(ekey, edge, ne[0])
         st.edges_popped += 1
-        ga = t.g[a]
-        chat = math.hypot(p.xy[x, 0] - p.xy[a, 0], p.xy[x, 1] - p.xy[a, 1])
+        ga = g[a]
+        chat = math.hypot(xy[x, 0] - xy[a, 0], xy[x, 1] - xy[a, 1])
         # g_T(a) + c_hat(a, x) + h_hat(x) < c_best ?
-        if ga + chat + p.h_hat[x] >= c_best:
+        if ga + chat + h_hat[x] >= c_best:
             continue
         # g_T(a) + c_hat(a, x) < g_T(x) ?  (also rejects edges already in the tree)
-        if ga + chat >= t.g[x] or t.parent[x] == a:
+        if ga + chat >= g[x] or parent[x] == a:
             continue
         # Exact, lazy edge check: is the straight motion free for the disc robot?
         st.edge_checks += 1
-        if segment_blocked_kernel(p.xy[a, 0], p.xy[a, 1], p.xy[x, 0], p.xy[x, 1], obs, limit):
+        if segment_blocked_kernel(xy[a, 0], xy[a, 1], xy[x, 0], xy[x, 1], obs, limit):
             st.edge_checks_failed += 1
             continue
         # The true cost equals the heuristic (straight line), so the tests above stand.
         gx_new = ga + chat
-        if t.vertex[x]:
-            delta = t.g[x] - gx_new
+        if vertex[x]:
+            delta = g[x] - gx_new
             _tree.detach(t, x)
             _tree.attach(t, x, a)
-            t.g[x] = gx_new
+            g[x] = gx_new
             _tree.shift_subtree(t, x, delta, stack)
             st.rewirings += 1
-            if t.expanded[x] == b.number:
-                t.expanded[x] = -1  # its queued edges are stale: expand it again
+            if expanded[x] == batch:
+                expanded[x] = -1  # its queued edges are stale: expand it again
         else:
-            t.vertex[x] = True
+            vertex[x] = True
             t.old[x] = False
-            t.g[x] = gx_new
+            g[x] = gx_new
             _tree.attach(t, x, a)
-            t.expanded[x] = -1
-        _queue.push_vertex(q, gx_new + p.h_hat[x], x)
-        if t.g[1] < c_best:
-            st.best = t.g[1]
+            expanded[x] = -1
+        nv[0] = _queue.push_vertex(vkey, vqueue, nv[0], gx_new + h_hat[x], x)
+        if g[1] < c_best:
+            st.best = g[1]
             return IMPROVED
     return BUDGET
 
@@ -224,11 +247,12 @@ def start_batch(p: Points, t: Tree, q: SearchQueue, b: Batch, pr: np.ndarray) ->
             m = _graph.near(b.new[i], p, b, b.radius, b.start, b.items, near, near_d)
             for u in range(m):
                 near_new[near[u]] = True
-    q.nv[0] = 0
+    vs = np.int64(0)  # not a literal: one specialisation of push_vertex
     c_best = pr[0].best
     for i in range(n):
         if t.vertex[i]:
             t.old[i] = True
             key = t.g[i] + p.h_hat[i]
             if key < c_best and (near_new[i] or t.expanded[i] < 0):
-                _queue.push_vertex(q, key, i)
+                vs = _queue.push_vertex(q.vkey, q.vertex, vs, key, i)
+    q.nv[0] = vs
