@@ -45,11 +45,6 @@ MATPLOTLIB_USERS = {"viz"}
 #: restructure removes; the test fails on any other break. Empty once the rooms are done.
 KNOWN: set[tuple[str, str]] = {
     ("anyplan.cli.main", "matplotlib"),  # picks the Agg backend: anyplan.viz.style does that now
-    ("anyplan.planning._bitstar_core", "anyplan.geometry._kernels"),
-    ("anyplan.planning.visgraph", "anyplan.geometry._kernels"),
-    ("anyplan.trajectory._kernels", "anyplan.geometry._kernels"),
-    ("anyplan.trajectory._kernels", "anyplan.geometry._kernels.segment_blocked"),
-    ("anyplan.trajectory._kernels", "anyplan.geometry._kernels.segment_clearance"),
 }
 
 
