@@ -108,3 +108,21 @@ def test_repeated_checks_give_the_direct_answers():
     first_collision(motion, obs, 0.3)
     again = first_collision(motion, moved, 0.3)
     assert _same(again, direct) and not _same(again, first_collision(motion, obs, 0.3))
+
+
+def test_unicycle_positions_are_the_chord_formula_bit_for_bit():
+    # Predictions evaluate UnicycleMotion.positions in every check; its straight fast path and
+    # inlined sinc must give exactly the contract's chord form with numpy's sinc.
+    rng = np.random.default_rng(7)
+    for i in range(400):
+        om = 0.0 if i % 2 else float(rng.uniform(-1.0, 1.0)) * 10.0 ** -float(rng.integers(0, 10))
+        m = UnicycleMotion(*rng.uniform(-10.0, 10.0, 2), float(rng.uniform(-7.0, 7.0)),
+                           float(rng.uniform(-2.0, 2.0)), om, float(rng.uniform(-5.0, 5.0)))
+        t = rng.uniform(-10.0, 60.0, int(rng.integers(1, 300)))
+        tau = np.maximum(t - m.start_time, 0.0)
+        half = 0.5 * m.omega * tau
+        chord = m.v * tau * np.sinc(half / np.pi)
+        ref = np.column_stack([m.x0 + chord * np.cos(m.theta0 + half),
+                               m.y0 + chord * np.sin(m.theta0 + half)])
+        assert np.array_equal(m.positions(t), ref)
+        assert np.array_equal(m.positions(float(t[0])), ref[:1])

@@ -14,6 +14,7 @@ A moving obstacle follows its motion whatever is in its way (it is not reactive)
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -68,6 +69,23 @@ class Motion:
         return ()
 
 
+_EPS = float(np.finfo(float).eps)
+
+
+def _sinc(x: np.ndarray) -> np.ndarray:
+    """``np.sinc(x)`` for a float array, by the same operations (without its per-call set-up)."""
+    y = math.pi * x
+    y = np.where(y, y, _EPS)
+    return np.sin(y) / y
+
+
+@functools.lru_cache(maxsize=256)
+def _straight_factors(theta0: float) -> tuple[float, float, float]:
+    """cos(theta0), sin(theta0) and sinc(0) as the array operations of the chord form give them."""
+    th = np.full(1, theta0) + np.zeros(1)
+    return float(np.cos(th)[0]), float(np.sin(th)[0]), float(_sinc(np.zeros(1))[0])
+
+
 @dataclass(frozen=True)
 class UnicycleMotion(Motion):
     """Constant (v, omega) motion from pose (x0, y0, theta0), starting at ``start_time``."""
@@ -90,13 +108,23 @@ class UnicycleMotion(Motion):
 
     def positions(self, t: np.ndarray) -> np.ndarray:
         tau = np.maximum(np.asarray(t, dtype=float) - self.start_time, 0.0)
+        out = np.empty((tau.size, 2))
+        if self.omega == 0.0:
+            # The chord form below with w = 0: half = 0, sinc = sin(eps) / eps (= 1) and the
+            # heading constant, so both are computed once (the same operations, the same bits).
+            c, sn, one = _straight_factors(self.theta0)
+            chord = self.v * tau * one
+            out[:, 0] = (self.x0 + chord * c).ravel()
+            out[:, 1] = (self.y0 + chord * sn).ravel()
+            return out
         # sin(th0 + w t) - sin(th0) = 2 cos(th0 + w t / 2) sin(w t / 2), and likewise for cos:
         # the chord form below equals the contract's formulas and stays exact as w -> 0.
         half = 0.5 * self.omega * tau
-        chord = self.v * tau * np.sinc(half / math.pi)
-        x = self.x0 + chord * np.cos(self.theta0 + half)
-        y = self.y0 + chord * np.sin(self.theta0 + half)
-        return np.column_stack([np.atleast_1d(x), np.atleast_1d(y)])
+        chord = self.v * tau * _sinc(half / math.pi)
+        th = self.theta0 + half
+        out[:, 0] = (self.x0 + chord * np.cos(th)).ravel()
+        out[:, 1] = (self.y0 + chord * np.sin(th)).ravel()
+        return out
 
     def state(self, t: float) -> tuple[float, float, float, float, float]:
         moving = t >= self.start_time
