@@ -6,8 +6,9 @@ paper-1..3 (``--seeds`` seeds), the first ``--random`` scenarios of ``random_sui
 trajectory and planned paths (a fingerprint), and the CPU time (``time.process_time``) of every
 planning call (``_replan``). With ``--trees A,B`` each repetition runs one worker process per
 tree, alternating, so that the load of the shared machine falls on both alike; it then tells
-whether the decisions are identical and prints per suite the median and p95 per-call CPU times
-and their ratios B / A.
+whether the decisions are identical (``--mode deterministic``) and prints per suite the median
+and p95 per-call CPU times and their ratios B / A. ``--mode bench`` runs the benchmark's
+settings instead (BIT* on a time budget), for timing only.
 
 Usage::
 
@@ -63,6 +64,8 @@ def worker(args: argparse.Namespace) -> dict[str, Any]:
     SpaceTimeBITStarAgent._replan = timed  # type: ignore[method-assign]
 
     def agent() -> Any:
+        if args.mode == "bench":  # benchmarks/spacetime.py's settings: BIT* on a time budget
+            return make_agent("st-bitstar", planning_delay=0.1)
         return make_agent("st-bitstar", planning_delay=0.1, batches_per_plan=2, max_time_s=10)
 
     scen = _scenarios(args)
@@ -90,7 +93,8 @@ def _stats(x: list[float]) -> tuple[float, float]:
 def driver(args: argparse.Namespace) -> int:
     trees = [os.path.abspath(t) for t in args.trees.split(",")]
     results: dict[str, list[dict[str, Any]]] = {t: [] for t in trees}
-    flags = ["--seeds", str(args.seeds), "--random", str(args.random), "--gaps", str(args.gaps)]
+    flags = ["--seeds", str(args.seeds), "--random", str(args.random), "--gaps", str(args.gaps),
+             "--mode", args.mode]
     for rep in range(args.reps):
         for t in trees:
             env = dict(os.environ, PYTHONPATH=os.path.join(t, "src"))
@@ -111,7 +115,9 @@ def driver(args: argparse.Namespace) -> int:
                         print(f"DIFFERENT ({key}): {t} {r1['scenario']} seed {r1['seed']}: "
                               f"{r0['status']} {r0['time_to_goal_s']} -> {r1['status']} "
                               f"{r1['time_to_goal_s']}")
-    print(f"decisions identical across trees and repetitions: {ok} ({len(ref)} runs)")
+    if args.mode == "bench":
+        ok = True  # a time budget: decisions depend on the load
+    print(f"decisions identical across trees and repetitions: {ok} ({len(ref)} runs, {args.mode})")
     for r in ref:
         print(f"  {r['suite']:6s} {r['scenario']:16s} seed {r['seed']}: {r['status']} "
               f"{r['time_to_goal_s']} core {r['core']} calls {len(r['cpu_s'])}")
@@ -146,6 +152,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--random", type=int, default=6)
     ap.add_argument("--gaps", type=int, default=6)
+    ap.add_argument("--mode", choices=("deterministic", "bench"), default="deterministic",
+                    help="deterministic (batch budget: decisions compared) or bench (the "
+                    "benchmark's time budget: decisions may differ with the load; timing only)")
     ap.add_argument("--out", default=None)
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
