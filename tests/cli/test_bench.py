@@ -14,10 +14,10 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "experiments"))
 
-import anyplan_bench_test_agents as agents  # noqa: E402
+import anyplan_bench_test_agents as agents
 
-from anyplan.cli.main import main  # noqa: E402
-from anyplan.experiments.tables import PlannerTable, Stat, TableRow, format_paper_comparison  # noqa: E402
+from anyplan.cli.main import main
+from anyplan.experiments.tables import PlannerTable, Stat, TableRow, format_paper_comparison
 
 agents.register_all()
 
@@ -90,7 +90,7 @@ def test_bench_resume_flag_and_refusal(tmp_path, tiny, capsys):
     assert "1 runs now, 1 already stored" in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("argv, message", [
+@pytest.mark.parametrize(("argv", "message"), [
     (["--planners", "strait"], "unknown planner 'strait'"),
     (["--runs", "0"], "--runs must be >= 1"),
     (["--jobs", "0"], "--jobs must be >= 1"),

@@ -21,7 +21,7 @@ def test_dovs_plot_at_time_zero(tmp_path) -> None:
     assert out.exists()
 
 
-@pytest.mark.parametrize("argv, needle", [
+@pytest.mark.parametrize(("argv", "needle"), [
     (["dovs-plot", "paper-1", "--time", "-1"], "--time"),
     (["dovs-plot", "paper-1", "--time", "nan"], "--time"),
     (["dovs-plot", "paper-1", "--time", "1e6"], "time limit"),

@@ -51,7 +51,8 @@ def test_bench_planning_runs_without_ompl_and_finds_detours(tmp_path, monkeypatc
     for r in runs:
         sc = by_hash[r["scenario_hash"]]
         straight = math.dist(sc.robot.start[:2], sc.robot.goal)
-        bound = lower_bound(Problem.create(sc.obstacle_set(), sc.robot.start[:2], sc.robot.goal, sc.robot.radius))
+        problem = Problem.create(sc.obstacle_set(), sc.robot.start[:2], sc.robot.goal, sc.robot.radius)
+        bound = lower_bound(problem)
         # A real detour: the optimum is longer than the straight line, and BIT* respects it.
         assert bound > straight + 1e-3
         if r["solved"]:

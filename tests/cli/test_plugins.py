@@ -107,5 +107,6 @@ def test_discovery_skips_taken_names_and_bad_values(monkeypatch, caplog):
 
     assert reg.get("other") is json_mod.JSONDecoder
     reg.register("gone", "json:NoSuchThing", origin="plugin from x 1")
-    with pytest.raises(LoadError, match=r"planner 'gone' \(plugin from x 1: json:NoSuchThing\).*AttributeError"):
+    with pytest.raises(LoadError,
+                       match=r"planner 'gone' \(plugin from x 1: json:NoSuchThing\).*AttributeError"):
         reg.get("gone")

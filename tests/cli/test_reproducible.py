@@ -51,8 +51,9 @@ def test_values_are_yaml_scalars_checked_against_the_settings():
     assert cfg == {"planning_delay": 0.1, "batches_per_plan": 2, "warm_start": True, "prediction_dt": None,
                    "wait_delays_s": (1.0, 2.5), "first_budget_s": 1e-3}
     assert isinstance(cfg["batches_per_plan"], int)
-    assert build_agent_config(SequentialBITStarAgent, "seq-bitstar",
-                              parse_set_options(["planning_delay=measured"])) == {"planning_delay": "measured"}
+    settings = parse_set_options(["planning_delay=measured"])
+    config = build_agent_config(SequentialBITStarAgent, "seq-bitstar", settings)
+    assert config == {"planning_delay": "measured"}
     assert "gains" not in agent_settings(SequentialBITStarAgent)  # objects are not command-line settings
 
 

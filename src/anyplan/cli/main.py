@@ -13,12 +13,12 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
-import os
 import sys
 from collections.abc import Sequence
 
 from anyplan import __version__
 from anyplan.errors import AnyplanError, UsageError, one_line
+from anyplan.viz.backend import pick_headless_backend
 
 __all__ = ["main", "COMMAND_MODULES", "UsageError", "FLAGS"]
 
@@ -62,22 +62,9 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _pick_backend() -> None:
-    """Select matplotlib's non-interactive Agg backend for the commands that draw, unless the
-    user chose a backend (MPLBACKEND, matplotlibrc, or matplotlib.use before calling main).
-    The library's viz modules never select one."""
-    if os.environ.get("MPLBACKEND"):
-        return
-    import matplotlib
-
-    chosen = getattr(matplotlib.rcParams, "_get_backend_or_none", lambda: None)()
-    if chosen is None and "matplotlib.pyplot" not in sys.modules:
-        matplotlib.use("Agg")
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code (0 success, 1 failure, 2 bad input)."""
-    _pick_backend()
+    pick_headless_backend()  # Agg for the commands that draw, unless the user chose a backend
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING - 10 * min(args.verbose, 2),
