@@ -10,7 +10,7 @@ from anyplan.experiments.db import STATUS, ResultsDB, progress_rows, run_row, se
 from anyplan.experiments.runner import PlannerSpec, run_bench
 from anyplan.world.scenario import load_scenario
 
-# What ompl_benchmark_statistics.py creates and Planner Arena reads (peers.md section 7).
+# What ompl_benchmark_statistics.py creates and Planner Arena reads (OMPL's benchmark database).
 OMPL_COLUMNS = {
     "experiments": ["id", "name", "totaltime", "timelimit", "memorylimit", "runcount", "version",
                     "hostname", "cpuinfo", "date", "seed", "setup"],

@@ -1,4 +1,4 @@
-"""Planning test problems: the peers' shared problem (shared/research/peers.md §1) and friends.
+"""Planning test problems: the peers' problem (benchmarks/scenarios/peers.yaml) and friends.
 
 Imported by the tests of this folder (``from planning_problems import ...``)."""
 
@@ -8,7 +8,7 @@ from anyplan.geometry import ObstacleSet, Polygon
 from anyplan.planning import Problem
 
 PEERS_RECTS = [(3.0, 0.0, 5.0, 7.0), (7.0, 4.0, 9.0, 11.0), (10.5, 2.0, 12.5, 8.0)]
-#: Exact optimum for a point robot, from extremitypathfinder (peers.md §1).
+#: Exact optimum for a point robot, from the extremitypathfinder oracle.
 PEERS_POINT_OPTIMUM = 22.233237
 
 

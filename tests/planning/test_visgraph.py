@@ -13,7 +13,7 @@ from anyplan.planning import PlannerStatus, Problem, VisGraphPlanner, lower_boun
 
 
 def test_peers_point_robot_optimum():
-    """peers.md §1: 22.233237 m via (3,7) (5,7) (7,4) (9,4) (10.5,8) for a point robot."""
+    """The peers' problem: 22.233237 m via (3,7) (5,7) (7,4) (9,4) (10.5,8) for a point robot."""
     p = peers_problem(0.0)
     lo = shortest_path(p, variant="lower")
     assert lo.status is PlannerStatus.EXACT_SOLUTION
@@ -84,7 +84,7 @@ def test_rounded_corner_matches_the_analytic_length():
 @pytest.mark.parametrize(("gap", "radius", "passes_under"), [(0.3, 0.25, False), (0.3, 0.1, True),
                                                               (0.0, 0.0, False)])
 def test_border_touching_and_near_border_obstacles(gap, radius, passes_under):
-    """peers.md §5.3: a gap to the wall narrower than 2 r is closed; a wider one is open."""
+    """Obstacles are not clipped at a wall: a gap to it narrower than 2 r is closed; a wider one is open."""
     obs = ObstacleSet([box(3.0, gap, 5.0, 7.0)], bounds=(0.0, 0.0, 10.0, 10.0))
     p = Problem.create(obs, (1.0, 1.0), (7.0, 1.0), radius)
     for variant in ("lower", "feasible"):
@@ -114,7 +114,7 @@ def test_peers_inflated_bounds_and_planner():
     res = planner.result()
     assert res.lower_bound is not None and res.lower_bound <= res.cost < res.lower_bound * 1.001
     assert p.path_valid(res.path)
-    # Square (Minkowski-box) inflation is an upper bound for a disc robot (peers.md: 24.0463).
+    # Square (Minkowski-box) inflation is an upper bound for a disc robot (its optimum: 24.0463).
     assert res.cost < 24.0463
 
 

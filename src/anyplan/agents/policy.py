@@ -3,23 +3,12 @@
 This is the bridge between learned policies and the benchmark: the vector is the one the
 Gymnasium environment ``anyplan/Nav-v0`` (:mod:`anyplan.gym`) gives, built by
 :class:`ObservationEncoder` from what the agent observes (its own state, the goal given at reset,
-the moving obstacles it sees; never the simulator's truth). A policy trained in the environment
-can therefore be run with ``anyplan run --planner policy --set policy=my_pkg.module:act`` or
-benchmarked beside ``seq-bitstar`` with ``anyplan bench --planners policy,seq-bitstar --set
-policy:policy=my_pkg.module:act``.
+the moving obstacles it sees; never the simulator's truth): float32, ``8 + 7 * max_obstacles``
+values, the robot's 8 then one slot of 7 per visible moving obstacle, nearest first. A policy
+trained in the environment runs with ``anyplan run --planner policy --set
+policy=my_pkg.module:act`` and is benchmarked beside ``seq-bitstar`` with ``anyplan bench``.
 
-Observation vector (float32, length ``8 + 7 * max_obstacles``; lengths in m, speeds in m/s,
-angles in rad, all in the arena frame):
-
-* robot, 8 values: ``goal_x - x``, ``goal_y - y``, ``cos(theta)``, ``sin(theta)``, ``v``,
-  ``omega``, ``x``, ``y``;
-* then ``max_obstacles`` slots of 7 values for the visible moving obstacles, nearest first:
-  ``present`` (1.0; 0.0 in a padding slot, whose other values are 0), ``x_o - x``, ``y_o - y``,
-  ``v_o cos(theta_o)``, ``v_o sin(theta_o)``, ``omega_o``, ``radius_o``. Obstacles beyond
-  ``max_obstacles`` are left out (the farthest ones).
-
-Static obstacles are not in the vector: they are fixed for a scenario (a policy meant for many
-layouts needs its own map input; see the environment's ``info["scenario"]``).
+The vector's layout: ``docs/integrations.md``, "Gymnasium: the observation vector".
 """
 
 from __future__ import annotations

@@ -1,20 +1,13 @@
 """Loading the compiled kernels before anything is timed.
 
 anyplan's hot loops are numba functions compiled on first use and cached on disk
-(``cache=True``). The very first process on a machine compiles them; later processes load the
-cached machine code. Agents call :func:`warm_up_kernels` in ``reset`` with the parts they use,
-so that neither cost lands inside a timed planning call: a robot's planner is a long-lived
-process, and loading its code is a start-up cost, not part of any replanning.
-
-Parts (each loads only its own kernels and those it calls):
-
-* ``"bitstar"``: BIT*'s search (batches, pruning, the blocked-edge repair);
-* ``"motion"``: the reference motion along a path (smoothing, speed profile, sampling);
-* ``"sequential"``: Sequential BIT*'s collision prediction against moving obstacles and one
-  replanning around a crossing obstacle (virtual squares, repairs, delayed departures).
-
-``on_compile`` is called once, when numba really starts compiling (a cache miss); loading
-cached code calls nothing, so a command can say "compiling" only when it is.
+(``cache=True``): the first process on a machine compiles them, later ones load the cached
+code. Agents call :func:`warm_up_kernels` in ``reset`` with the parts they use (``"bitstar"``:
+BIT*'s search; ``"motion"``: smoothing, speed profile and sampling; ``"sequential"``: collision
+prediction and one replanning around a crossing obstacle), so that neither cost lands inside a
+timed planning call: loading a planner's code is a start-up cost, not part of a replanning.
+``on_compile`` is called once, when numba really compiles (a cache miss), so a command can say
+"compiling" only when it is. ``docs/motion.md``, "Compiled kernels".
 """
 
 from __future__ import annotations

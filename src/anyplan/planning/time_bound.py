@@ -2,21 +2,13 @@
 
 ``time_lower_bound_s`` of a scenario is the least time in which the robot, starting at rest,
 can reach the edge of the goal tolerance disc under ``|v| <= v_max`` and ``|dv/dt| <= a_max``,
-ignoring the turn-rate limits and every moving obstacle:
+ignoring the turn-rate limits and every moving obstacle: the length L of the shortest path
+among the static obstacles (the visibility graph's proven lower bound) minus the goal tolerance,
+driven from rest at a_max up to v_max. No robot beats it, so ``time_to_goal /
+time_lower_bound_s >= 1`` for every run. It is computed once per static layout; on an
+occupancy-grid map L is the straight start-goal distance (looser, but fast).
 
-* the distance is the length L of the shortest path among the static obstacles (the
-  visibility graph's ``"lower"`` variant, itself a proven lower bound on the optimum, see
-  :mod:`anyplan.planning.visgraph`) minus the goal tolerance: any path into the tolerance disc
-  is at least L - tol long;
-* over a distance d from rest with a free arrival speed (the run ends as the robot enters the
-  disc; it need not stop there), the fastest profile accelerates at a_max up to v_max and
-  cruises: ``d / v_max + v_max / (2 a_max)`` when ``d >= v_max^2 / (2 a_max)``, otherwise it
-  never reaches v_max and takes ``sqrt(2 d / a_max)``.
-
-No robot can beat the bound, so ``time_to_goal / time_lower_bound_s >= 1`` for every run.
-The bound of a scenario is computed once per static layout (a cache keyed by its content).
-On an occupancy-grid map (``static_map``) the visibility graph of the map's many corners takes
-tens of seconds, so there L is the straight start-goal distance: still a lower bound, looser.
+The derivation: ``docs/planning.md``, "Time lower bound".
 """
 
 from __future__ import annotations

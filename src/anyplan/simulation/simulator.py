@@ -1,21 +1,14 @@
 """The simulator: one loop that serves every agent alike.
 
-Each step of ``dt`` seconds:
+Each step of ``dt`` seconds the agent gets an :class:`~anyplan.agents.base.Observation` (its
+pose and twist, and the moving obstacles it can see) and returns a command; the command is
+clipped to the robot's limits and the unicycle integrated exactly; the moving obstacles follow
+their true motions; collisions are tested over the whole step (chords, exactly), not only at
+its end. The run ends at the goal, at the first collision or at the time limit, or at once with
+status ``unreachable`` when the goal is proven out of reach
+(:func:`~anyplan.simulation.feasibility.goal_unreachable`).
 
-1. the agent gets an :class:`~anyplan.agents.base.Observation` (its pose and twist, and the
-   moving obstacles it can see) and returns a command;
-2. the command is clipped to the robot's dynamic limits and the unicycle is integrated exactly;
-3. the moving obstacles follow their true motions;
-4. collisions are tested over the whole step, not only at its end: the robot's chord against
-   the static shapes and walls exactly, and the closest approach of the robot's and each
-   obstacle's chords in relative motion. (Over dt = 0.05 s the chord of a 0.4 rad/s arc departs
-   from the arc by less than 0.1 mm.)
-
-The run ends at the goal (within ``goal_tolerance``), at the first collision (unless
-``stop_on_collision`` is off) or at the time limit. Before the first step, when the visibility
-graph proves the goal out of reach among the static obstacles
-(:func:`~anyplan.simulation.feasibility.goal_unreachable`), the run ends at once with status
-``unreachable``.
+One step in detail: ``docs/experiments.md``, "The simulator: one step".
 """
 
 from __future__ import annotations
