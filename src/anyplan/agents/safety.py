@@ -30,7 +30,7 @@ from anyplan.trajectory.reference import HoldSegment, come_to_rest
 from anyplan.trajectory.trajectory import BrakeSegment, Trajectory
 from anyplan.world.robot import RobotSpec, RobotState
 
-__all__ = ["SafetyConfig", "Decision", "Escape", "SafetyGuard", "escape_motion", "FALLBACK_KINDS"]
+__all__ = ["SafetyConfig", "Decision", "Escape", "SafetyGuard", "FALLBACK_KINDS"]
 
 #: The fallback kinds, in order of preference when their clearances tie.
 FALLBACK_KINDS = ("hold", "brake", "turn_away", "back_off")
@@ -98,12 +98,6 @@ class Escape:
                 x, y, _, _, _ = self.brake.sample(np.minimum(t[late], self.brake.t1))
                 p[late, 0], p[late, 1] = x, y
         return p
-
-
-def escape_motion(motion: Any, t_commit: float, spec: RobotSpec, obstacles: ObstacleSet,
-                  radius: float | None = None) -> Escape:
-    """The escape of ``motion`` braking from ``t_commit`` [s] (see :class:`Escape`)."""
-    return Escape(motion, t_commit, spec, obstacles, spec.radius if radius is None else radius)
 
 
 @dataclass
