@@ -102,6 +102,28 @@ def test_unreachable_goal_is_a_clear_failure():
     assert res.status == "plan_failed" and res.motion is None and len(res.path) == 0
 
 
+def test_a_batch_budget_gives_up_on_an_unreachable_goal_by_work_not_time():
+    # With batches_per_plan, a search that finds no solution stops after 20 x the batches (not
+    # after a wall-clock cap, which made --deterministic runs differ run to run).
+    sc = load_scenario("paper-1")
+    obst = sc.obstacle_set().with_shapes([rectangle((10.0, 5.5), (0.4, 11.0))])
+    spec = sc.robot
+
+    def motion_fn(path, shapes, delay):
+        raise AssertionError("no path exists, so no motion is built")
+
+    cfg = SequentialConfig(batches_per_plan=2)
+    out = []
+    for _ in range(2):
+        loop = SequentialBITStar(obst, robot_radius=spec.radius, plan_radius=spec.radius + 0.03,
+                                 motion=motion_fn, config=cfg, rng=np.random.default_rng(0))
+        res = loop.replan(np.array(spec.start[:2]), np.array(spec.goal), [], 0.0)
+        assert res.status == "plan_failed"
+        out.append((loop.rng.bit_generator.state["state"], res.plan_time_s))
+    assert out[0][0] == out[1][0]  # the same samples drawn: the same amount of work
+    assert max(t for _, t in out) < 10.0
+
+
 def test_obstacle_parked_on_the_goal_makes_the_robot_wait_or_report():
     sc = load_scenario("paper-1")
     spec = sc.robot

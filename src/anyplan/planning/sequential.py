@@ -56,7 +56,8 @@ class SequentialConfig:
         first_budget_s: BIT* budget of the first plan (among the static obstacles).
         iteration_budget_s: BIT* budget after each virtual obstacle is added.
         batches_per_plan: If set, each plan stops after this many batches (after a first
-            solution) instead of a time budget: the search is then deterministic for a seed.
+            solution), or after 20 times as many without one, instead of a time budget: the
+            search is then deterministic for a seed.
         warm_start: Continue the previous search after adding a square (else start anew, the
             default: measured faster by ``benchmarks/replan.py``).
         margin: Extra clearance [m] required between the robot's reference and an obstacle in
@@ -233,7 +234,11 @@ class SequentialBITStar:
     def _budget(self, first: bool) -> Any:
         cfg = self.config
         if cfg.batches_per_plan is not None:
-            return any_of(batches(cfg.batches_per_plan) & first_solution(), timed(10.0))
+            # Work, not time, decides when a search without a solution gives up (20 times the
+            # batches, as the timed budget below allows 20 budgets): a search that may not find
+            # one (a robot boxed in by its squares) stays deterministic.
+            n = cfg.batches_per_plan
+            return any_of(batches(n) & first_solution(), batches(20 * n), timed(10.0))
         budget = cfg.first_budget_s if first else cfg.iteration_budget_s
         # At least a first solution: keep searching (up to 20 budgets) until one exists.
         return any_of(timed(budget) & first_solution(), timed(20.0 * budget))
