@@ -4,7 +4,8 @@ Every control period T (``control_period_s``, default 0.2 s, i.e. every 4th simu
 0.05 s) the agent builds the DOVS from the observed moving obstacles (pose and twist, assumed
 constant) and the static map given at reset, picks a command with the greedy selector and holds
 it until the next period. ``stats.planning_times_s`` holds the wall-clock time of each period's
-computation; ``stats.extra`` counts how often each selection mode and goal target was used.
+computation; its record (:class:`~anyplan.agents.stats.DOVSStats`) counts how often each
+selection mode and goal target was used.
 
 By default the config's ``limits`` are the scenario's robot's
 (:attr:`~anyplan.world.robot.RobotSpec.limits`), so that the dynamic window never asks for more
@@ -21,7 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from anyplan.agents.base import Agent, Observation
+from anyplan.agents.base import Agent, AgentStats, Observation
+from anyplan.agents.stats import DOVSStats
 from anyplan.baselines.dovs.config import DOVSConfig, DOVSConfigError
 from anyplan.baselines.dovs.model import StaticMap
 from anyplan.baselines.dovs.planner import Decision, DOVSPlanner
@@ -63,6 +65,7 @@ class DOVSAgent(Agent):
         self.config = self.base_config
         self.planner: DOVSPlanner | None = None
         self.last_decision: Decision | None = None
+        self.record = DOVSStats()
 
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
         spec = scenario.robot
@@ -77,10 +80,8 @@ class DOVSAgent(Agent):
         self._held = Command(0.0, 0.0)
         self._modes: Counter[str] = Counter()
         self._targets: Counter[str] = Counter()
-        self.stats.planning_times_s.clear()
-        self.stats.extra.clear()
-        self.stats.extra.update({"control_period_s": cfg.control_period_s,
-                                 "dovs_config": cfg.to_dict()})
+        self.record = DOVSStats(control_period_s=cfg.control_period_s, dovs_config=cfg.to_dict())
+        self.stats = AgentStats(record=self.record)
 
     def decide(self, obs: Observation) -> Decision:
         """Run one DOVS period on ``obs`` (does not change the held command or the stats)."""
@@ -105,6 +106,6 @@ class DOVSAgent(Agent):
         self._next_t = obs.t + self.config.control_period_s
         self._modes[d.selection.mode] += 1
         self._targets[d.goal.mode] += 1
-        self.stats.extra["selection_modes"] = dict(self._modes)
-        self.stats.extra["goal_targets"] = dict(self._targets)
+        self.record.selection_modes = dict(self._modes)
+        self.record.goal_targets = dict(self._targets)
         return self._held

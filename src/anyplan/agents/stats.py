@@ -7,8 +7,8 @@ out. ``WALL_CLOCK`` lists the keys that hold wall-clock measurements (the agent'
 its record in ``stats.record`` (:class:`~anyplan.agents.base.AgentStats`).
 
 Records: :class:`SequentialStats` (``seq-bitstar``), :class:`SpaceTimeStats` (``st-bitstar``),
-:class:`BITStarStats` (``bitstar``), :class:`TrackerCounts` (the ``tracking`` entry of the
-perceiving wrapper). ``straight``, ``orca`` and ``policy`` report no ``extra``.
+:class:`BITStarStats` (``bitstar``), :class:`DOVSStats` (``dovs``), :class:`TrackerCounts` (the
+``tracking`` entry of the perceiving wrapper). ``straight``, ``orca`` and ``policy`` report no ``extra``.
 """
 
 from __future__ import annotations
@@ -16,7 +16,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
-__all__ = ["StatsRecord", "SequentialStats", "SpaceTimeStats", "BITStarStats", "TrackerCounts"]
+__all__ = ["StatsRecord", "SequentialStats", "SpaceTimeStats", "BITStarStats", "DOVSStats",
+           "TrackerCounts"]
 
 
 @dataclass
@@ -173,3 +174,26 @@ class BITStarStats(StatsRecord):
     progress: list[list[float]] | None = None
     tracking_rms_m: float | None = None
     tracking_max_m: float | None = None
+
+
+@dataclass
+class DOVSStats(StatsRecord):
+    """``dovs``: its settings, then counts over the control periods.
+
+    Attributes:
+        control_period_s: DOVS's control period [s].
+        dovs_config: Its settings (``DOVSConfig.to_dict()``).
+        selection_modes: How often each velocity-selection mode was used.
+        goal_targets: How often each goal-target mode was used.
+        tracking: The tracker's counts (``tracked`` perception).
+    """
+
+    KEYS: ClassVar[tuple[str, ...]] = ("control_period_s", "dovs_config", "selection_modes",
+                                       "goal_targets", "tracking")
+    OPTIONAL: ClassVar[frozenset[str]] = frozenset({"selection_modes", "goal_targets",
+                                                    "tracking"})
+
+    control_period_s: float | None = None
+    dovs_config: dict[str, Any] | None = None
+    selection_modes: dict[str, int] | None = None
+    goal_targets: dict[str, int] | None = None
