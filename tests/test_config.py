@@ -42,3 +42,20 @@ def test_valid_values_pass_and_describe_lists_specs():
     assert rows["dt"].line() == "dt = 0.05  (float, in [0.001, 0.05], s): step"
     assert rows["limit"].type_name == "float or None"
     assert describe(_Demo(n=7))[1].default == 7  # an instance's values are the defaults
+
+
+@pytest.mark.parametrize(("cls", "field", "bad"), [
+    ("anyplan.control.kanayama:KanayamaGains", "k_y", -1.0),
+    ("anyplan.agents.safety:SafetyConfig", "horizon_s", 0.0),
+    ("anyplan.agents.safety:SafetyConfig", "offsets_m", (0.6, -1.0)),
+    ("anyplan.prediction.tracking:TrackerConfig", "drop_after_s", 0.0),
+    ("anyplan.prediction.tracking:TrackerConfig", "sigma_m", float("nan")),
+])
+def test_every_settings_dataclass_validates_through_the_helper(cls, field, bad):
+    import importlib
+
+    mod, name = cls.split(":")
+    klass = getattr(importlib.import_module(mod), name)
+    with pytest.raises(SettingError, match=rf"^{name}\.{field}: "):
+        klass(**{field: bad})
+    assert {f.name for f in describe(klass())} >= {field}

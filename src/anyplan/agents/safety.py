@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from anyplan.config import setting, validate
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.moving import closest_approach
 from anyplan.prediction.base import PredictedObstacle
@@ -51,20 +52,17 @@ class SafetyConfig:
         tol: Time accuracy [s] of the clearance search.
     """
 
-    margin: float = 0.05
-    recheck_margin: float = 0.025
-    horizon_s: float = 5.0
-    offsets_m: tuple[float, ...] = (0.6, 1.2)
-    sample_dt: float | None = 0.02
-    tol: float = 1e-3
+    margin: float = setting(0.05, lo=0.0, unit="m", doc="clearance to each predicted disc")
+    recheck_margin: float = setting(0.025, lo=0.0, unit="m", doc="margin of still_safe")
+    horizon_s: float = setting(5.0, lo=0.0, lo_open=True, unit="s", doc="fallback ranking horizon")
+    offsets_m: tuple[float, ...] = setting((0.6, 1.2), lo=0.0, lo_open=True, unit="m",
+                                           doc="turn_away / back_off distances")
+    sample_dt: float | None = setting(0.02, lo=0.0, lo_open=True, unit="s",
+                                      doc="predictor resampling step (None: exact)")
+    tol: float = setting(1e-3, lo=0.0, lo_open=True, unit="s", doc="clearance search accuracy")
 
     def __post_init__(self) -> None:
-        if self.margin < 0.0 or self.recheck_margin < 0.0:
-            raise ValueError("margin, recheck_margin: must be >= 0")
-        if not self.horizon_s > 0.0:
-            raise ValueError(f"horizon_s: must be > 0, got {self.horizon_s}")
-        if any(d <= 0.0 for d in self.offsets_m):
-            raise ValueError("offsets_m: distances must be > 0")
+        validate(self)
 
 
 class Escape:

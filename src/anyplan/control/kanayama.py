@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from anyplan.config import setting, validate
 from anyplan.geometry.se2 import wrap_angle
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import Command, RobotSpec, RobotState, clip_command
@@ -38,15 +39,13 @@ class KanayamaGains:
         k_turn: Heading gain [1/s] independent of v_r (our addition; 0 = Kanayama's law).
     """
 
-    k_x: float = 2.0
-    k_y: float = 16.0
-    k_theta: float = 8.0
-    k_turn: float = 2.0
+    k_x: float = setting(2.0, lo=0.0, unit="1/s", doc="along-track gain")
+    k_y: float = setting(16.0, lo=0.0, unit="1/m^2", doc="cross-track gain")
+    k_theta: float = setting(8.0, lo=0.0, unit="1/m", doc="heading gain")
+    k_turn: float = setting(2.0, lo=0.0, unit="1/s", doc="heading gain independent of v_r")
 
     def __post_init__(self) -> None:
-        for name in ("k_x", "k_y", "k_theta", "k_turn"):
-            if not getattr(self, name) >= 0.0:
-                raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}")
+        validate(self)
 
 
 def tracking_errors(x_r: float, y_r: float, th_r: float, state: RobotState) -> tuple[float, float, float]:

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from anyplan.config import setting, validate
 from anyplan.prediction.detection import Detection
 
 __all__ = ["TrackerConfig", "Tracker", "TrackEstimate", "ct_transition"]
@@ -40,13 +41,19 @@ class TrackerConfig:
         drop_after_s: A track not detected for this long [s] is dropped.
     """
 
-    sigma_m: float = 0.05
-    q_cv: float = 0.05
-    q_ct: float = 0.05
-    q_omega: float = 0.02
-    switch_rate: float = 0.5
-    init_speed_sigma: float = 1.0
-    drop_after_s: float = 2.0
+    sigma_m: float = setting(0.05, lo=0.0, unit="m", doc="measurement noise per axis")
+    q_cv: float = setting(0.05, lo=0.0, lo_open=True, unit="m^2/s^3", doc="CV acceleration noise")
+    q_ct: float = setting(0.05, lo=0.0, lo_open=True, unit="m^2/s^3", doc="CT acceleration noise")
+    q_omega: float = setting(0.02, lo=0.0, lo_open=True, unit="rad^2/s^3",
+                             doc="CT turn-rate random walk")
+    switch_rate: float = setting(0.5, lo=0.0, unit="1/s", doc="model switching rate")
+    init_speed_sigma: float = setting(1.0, lo=0.0, lo_open=True, unit="m/s",
+                                      doc="velocity sigma of a new track")
+    drop_after_s: float = setting(2.0, lo=0.0, lo_open=True, unit="s",
+                                  doc="a track unseen this long is dropped")
+
+    def __post_init__(self) -> None:
+        validate(self)
 
 
 @dataclass(frozen=True)
