@@ -64,6 +64,6 @@ def test_with_ompl_bitstar(tmp_path):
 
 def test_bad_input(tmp_path):
     sc = scenario_from_dict(WALL)
-    with pytest.raises(BenchError, match="--budget"):
+    with pytest.raises(BenchError, match="budget_s must be > 0"):
         run_planning_bench([sc], tmp_path / "p.db", budget_s=0.0, ompl=None)
     assert not (tmp_path / "p.db").exists()

@@ -66,7 +66,7 @@ def test_gif_shows_virtual_obstacles_from_their_creation_time(tmp_path):
 def test_check_target_errors():
     with pytest.raises(ValueError, match=r"\.gif or \.mp4"):
         check_target("x.avi")
-    with pytest.raises(ValueError, match="--speed must be > 0"):
+    with pytest.raises(ValueError, match="speed must be > 0"):
         check_target("x.gif", 0.0)
 
 

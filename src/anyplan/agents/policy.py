@@ -93,7 +93,7 @@ class PolicyAgent(Agent):
     def __init__(self, policy: str | None = None, max_obstacles: int = 8) -> None:
         super().__init__()
         if policy is None:
-            raise ValueError("policy: give the policy as 'module:function' (--set policy=...)")
+            raise ValueError("policy: give the policy as 'module:function' (the setting policy=...)")
         self.policy_ref = policy if isinstance(policy, str) else None
         self._fn = _load(policy) if isinstance(policy, str) else policy
         if not callable(self._fn):

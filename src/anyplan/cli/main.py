@@ -25,7 +25,11 @@ __all__ = ["main", "COMMAND_MODULES", "UsageError", "FLAGS"]
 #: Library field and parameter names (:attr:`AnyplanError.subject`) -> the flags that set them.
 FLAGS = {"runs": "--runs", "jobs": "--jobs", "planners": "--planners", "config": "--config",
          "scheduler": "--scheduler", "per_count": "--random-count", "suite": "--suite",
-         "setting": "--set", "deterministic": "--deterministic"}
+         "setting": "--set", "deterministic": "--deterministic", "budget_s": "--budget",
+         "ompl": "--ompl", "mcap": "--mcap", "source": "--source", "worlds_file": "--worlds-file",
+         "worlds": "--worlds", "window_s": "--window", "step_s": "--step", "margin_m": "--margin",
+         "edge_m": "--edge", "sensing_range_m": "--sensing-range", "noise_m": "--sensor-noise",
+         "rate_hz": "--sensor-rate", "copies": "--copies", "copy_shift_s": "--copy-shift"}
 
 #: Modules that each register one or more sub-commands.
 COMMAND_MODULES = [

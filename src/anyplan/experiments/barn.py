@@ -102,7 +102,7 @@ def load_worlds(path: str | Path) -> list[dict[str, Any]]:
     """
     p = Path(path)
     if not p.is_file():
-        raise BARNError(f"{p}: no such file (pass --source PATH to the BARN worlds.json)")
+        raise BARNError.about(str(p), ": no such file (pass {source} PATH to the BARN worlds.json)", "source")
     try:
         data = json.loads(p.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:

@@ -61,14 +61,13 @@ class CrowdOptions:
         for name in ("window_s", "step_s", "margin_m", "edge_m", "sensing_range_m", "rate_hz"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v > 0.0):
-                raise CrowdError(f"import-crowd: --{name.rsplit('_', 1)[0].replace('_', '-')} must "
-                                 f"be > 0, got {v:g}")
+                raise CrowdError.about(name, f" must be > 0, got {v:g}")
         if not (math.isfinite(self.noise_m) and self.noise_m >= 0.0):
-            raise CrowdError(f"import-crowd: --sensor-noise must be >= 0 m, got {self.noise_m:g}")
+            raise CrowdError.about("noise_m", f" must be >= 0 m, got {self.noise_m:g}")
         if self.copies < 1:
-            raise CrowdError(f"import-crowd: --copies must be >= 1, got {self.copies}")
+            raise CrowdError.about("copies", f" must be >= 1, got {self.copies}")
         if self.edge_m >= self.margin_m:
-            raise CrowdError("import-crowd: --edge must be smaller than --margin")
+            raise CrowdError.about("edge_m", " must be smaller than {margin_m}", "margin_m")
         for k, v in (self.robot or {}).items():
             if not (math.isfinite(v) and v > 0.0):
                 raise CrowdError(f"import-crowd: robot {k} must be > 0, got {v:g}")

@@ -63,7 +63,8 @@ def load_worlds(path: str | Path) -> list[dict[str, Any]]:
     """
     p = Path(path)
     if not p.is_file():
-        raise DynaBARNError(f"{p}: no such file (pass --worlds-file PATH to the DynaBARN worlds.json)")
+        raise DynaBARNError.about(
+            str(p), ": no such file (pass {worlds_file} PATH to the DynaBARN worlds.json)", "worlds_file")
     try:
         data = json.loads(p.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
@@ -87,14 +88,14 @@ def parse_worlds(spec: str, n_worlds: int = 60,
         item = item.strip()
         m = re.fullmatch(r"(\d+)(?:-(\d+))?", item)
         if not m:
-            raise error(f"--worlds: '{item}' is not an index or a range like 0-{n_worlds - 1}")
+            raise error.about("worlds", f": '{item}' is not an index or a range like 0-{n_worlds - 1}")
         a = int(m.group(1))
         b = int(m.group(2)) if m.group(2) else a
         if a > b:
-            raise error(f"--worlds: empty range '{item}'")
+            raise error.about("worlds", f": empty range '{item}'")
         for i in range(a, b + 1):
             if not 0 <= i < n_worlds:
-                raise error(f"--worlds: index {i} is outside 0-{n_worlds - 1}")
+                raise error.about("worlds", f": index {i} is outside 0-{n_worlds - 1}")
             if i not in out:
                 out.append(i)
     return out

@@ -69,10 +69,10 @@ def check_target(path: str | Path) -> None:
     try:
         import mcap_ros2.writer  # noqa: F401
     except ImportError:
-        raise McapUnavailable("--mcap needs the 'mcap' extra: pip install 'anyplan[mcap]'") from None
+        raise McapUnavailable.about("mcap", " needs the 'mcap' extra: pip install 'anyplan[mcap]'") from None
     folder = Path(path).parent
     if not folder.is_dir():
-        raise McapUnavailable(f"--mcap {path}: folder {folder} does not exist")
+        raise McapUnavailable.about("mcap", f" {path}: folder {folder} does not exist")
 
 
 def stamp(t: float) -> dict[str, int]:
@@ -175,7 +175,7 @@ def write_mcap(path: str | Path, scenario: Scenario, result: RunResult | Mapping
     try:
         from mcap_ros2.writer import Writer
     except ImportError:
-        raise McapUnavailable("--mcap needs the 'mcap' extra: pip install 'anyplan[mcap]'") from None
+        raise McapUnavailable.about("mcap", " needs the 'mcap' extra: pip install 'anyplan[mcap]'") from None
     res = result.to_dict() if isinstance(result, RunResult) else dict(result)
     traj = np.asarray(res["trajectory"], dtype=float).reshape(-1, 6)
     summary = McapSummary(Path(path), dict.fromkeys(TOPICS, 0))

@@ -165,20 +165,20 @@ def run_planning_bench(scenarios: Sequence[Scenario], db_path: str | Path, *, ru
     """
     stream = stream if stream is not None else sys.stderr
     if runs < 1:
-        raise BenchError(f"--runs must be >= 1, got {runs}")
+        raise BenchError.about("runs", f" must be >= 1, got {runs}")
     if not budget_s > 0.0:
-        raise BenchError(f"--budget must be > 0 s, got {budget_s}")
+        raise BenchError.about("budget_s", f" must be > 0 s, got {budget_s}")
     names = list(ompl or [])
     if names:
         if not ompl_available():
-            raise BenchError("OMPL planners need the ompl wheel: pip install 'anyplan[bench]' "
-                             "(or pass --ompl none)")
+            raise BenchError.about("", "OMPL planners need the ompl wheel: pip install "
+                                   "'anyplan[bench]' (or pass {ompl} none)", "ompl")
         from ompl import geometric as og
         from ompl import util as ou
 
         unknown = [n for n in names if not hasattr(og, n)]
         if unknown:
-            raise BenchError(f"--ompl: unknown OMPL planner(s) {', '.join(unknown)}")
+            raise BenchError.about("ompl", f": unknown OMPL planner(s) {', '.join(unknown)}")
         ou.setLogLevel(ou.LOG_ERROR)
         ou.RNG.setSeed(int(master_seed) % (2**31 - 1) + 1)
     planners = [OURS] + [f"geometric_{n}" for n in names]

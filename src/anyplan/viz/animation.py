@@ -47,7 +47,7 @@ def check_target(path: str | Path, speed: float = 4.0) -> None:
     if suffix == ".mp4" and not ffmpeg_available():
         raise ValueError("MP4 needs ffmpeg on the PATH; install it or write a .gif")
     if not speed > 0.0:
-        raise ValueError(f"--speed must be > 0, got {speed:g}")
+        raise ValueError(f"speed must be > 0, got {speed:g}")
 
 
 def _write_gif(frames: list[np.ndarray], path: Path, fps: float) -> None:
