@@ -97,8 +97,9 @@ def make_cases(n_random: int) -> list[dict]:
 def agent_calls(n_random: int) -> list[tuple[tuple, dict]]:
     """The plan_motion calls (arguments) of the seq-bitstar agent in closed loop on paper-1..3
     and ``n_random`` random scenarios, seeds 0 and 1 (recorded by wrapping the function the
-    agent module imported; nothing is changed on disk)."""
-    import anyplan.agents.sequential as seq_agent
+    agent's reference-motion builder, :mod:`anyplan.trajectory.reference`, imported; nothing is
+    changed on disk)."""
+    import anyplan.trajectory.reference as seq_agent
     from anyplan.agents import make_agent
     from anyplan.simulation import simulate
 
