@@ -33,7 +33,8 @@ from typing import Any
 
 from anyplan.errors import AnyplanError
 
-__all__ = ["SettingError", "Spec", "FieldInfo", "setting", "spec_of", "validate", "describe"]
+__all__ = ["SettingError", "Spec", "FieldInfo", "setting", "spec_of", "validate", "describe",
+           "type_name"]
 
 _KEY = "anyplan.setting"
 
@@ -218,18 +219,19 @@ def describe(config: Any) -> list[FieldInfo]:
                        else None)
         else:
             default = getattr(config, f.name)
-        out.append(FieldInfo(f.name, default, _type_name(hints.get(f.name, Any)), spec_of(f) or Spec()))
+        out.append(FieldInfo(f.name, default, type_name(hints.get(f.name, Any)), spec_of(f) or Spec()))
     return out
 
 
-def _type_name(hint: Any) -> str:
+def type_name(hint: Any) -> str:
+    """A type hint in words for listings, e.g. ``float or None``, ``list of float``."""
     if hint is type(None):
         return "None"
     args = typing.get_args(hint)
     if typing.get_origin(hint) in (typing.Union, types.UnionType):
-        return " or ".join(_type_name(a) for a in args)
+        return " or ".join(type_name(a) for a in args)
     if typing.get_origin(hint) is tuple:
-        return f"list of {_type_name(args[0])}" if args else "list"
+        return f"list of {type_name(args[0])}" if args else "list"
     if typing.get_origin(hint) is typing.Literal:
         return " or ".join(repr(a) for a in args)
     return getattr(hint, "__name__", str(hint))

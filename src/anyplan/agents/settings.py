@@ -23,7 +23,7 @@ from typing import Any
 
 import yaml
 
-from anyplan.config import Spec, describe
+from anyplan.config import Spec, describe, type_name
 from anyplan.errors import AnyplanError, UnknownNameError
 
 __all__ = ["Setting", "SettingsError", "agent_settings", "parse_set_options", "build_agent_config",
@@ -61,16 +61,7 @@ class Setting:
 def _hint_name(hint: Any) -> str:
     if hint is None or hint is inspect.Parameter.empty:
         return "any"
-    if hint is type(None):
-        return "None"
-    args = typing.get_args(hint)
-    if typing.get_origin(hint) in (typing.Union, types.UnionType):
-        return " or ".join(_hint_name(a) for a in args)
-    if typing.get_origin(hint) is tuple:
-        return f"list of {_hint_name(args[0])}" if args else "list"
-    if typing.get_origin(hint) is typing.Literal:
-        return " or ".join(repr(a) for a in args)
-    return getattr(hint, "__name__", str(hint))
+    return type_name(hint)
 
 
 def _settable(hint: Any) -> bool:

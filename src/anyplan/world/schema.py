@@ -187,15 +187,22 @@ def _unicycle(c: Ctx, m: Mapping[str, Any], fld: str) -> Motion:
     return UnicycleMotion(x0, y0, th0, v, omega, t0)
 
 
+def _timed_rows(c: Ctx, m: Mapping[str, Any], fld: str, key: str) -> list[tuple[float, ...]]:
+    """The ``[t, x, y]`` rows under ``key`` of a timed motion (``waypoints`` keyframes, ``track``
+    samples): at least 2, each checked, times increasing (:func:`_check_rows`)."""
+    c.keys(m, fld, ("type", key, "radius"), ("name",))
+    raw = m[key]
+    sub = join_field(fld, key)
+    if not isinstance(raw, list) or len(raw) < 2:
+        raise c.fail(sub, "expected a list of at least 2 [t, x, y] rows")
+    c.items(raw, sub, L.MAX_KEYFRAMES)
+    rows = [c.vector(r, f"{sub}[{i}]", 3, hi=L.MAX_EVENT_TIME_S) for i, r in enumerate(raw)]
+    _check_rows(c, rows, sub)
+    return rows
+
+
 def _waypoints(c: Ctx, m: Mapping[str, Any], fld: str) -> Motion:
-    c.keys(m, fld, ("type", "keyframes", "radius"), ("name",))
-    kf = m["keyframes"]
-    if not isinstance(kf, list) or len(kf) < 2:
-        raise c.fail(join_field(fld, "keyframes"), "expected a list of at least 2 [t, x, y] rows")
-    c.items(kf, join_field(fld, "keyframes"), L.MAX_KEYFRAMES)
-    rows = [c.vector(r, f"{join_field(fld, 'keyframes')}[{i}]", 3, hi=L.MAX_EVENT_TIME_S)
-            for i, r in enumerate(kf)]
-    _check_rows(c, rows, join_field(fld, "keyframes"))
+    rows = _timed_rows(c, m, fld, "keyframes")
     try:
         motion = WaypointMotion(np.array(rows))
         speed = motion.max_speed
@@ -264,14 +271,7 @@ def _check_rows(c: Ctx, rows: list[tuple[float, ...]], fld: str) -> None:
 
 
 def _parse_track(c: Ctx, m: Mapping[str, Any], fld: str) -> Motion:
-    c.keys(m, fld, ("type", "samples", "radius"), ("name",))
-    rows_raw = m["samples"]
-    if not isinstance(rows_raw, list) or len(rows_raw) < 2:
-        raise c.fail(join_field(fld, "samples"), "expected a list of at least 2 [t, x, y] rows")
-    c.items(rows_raw, join_field(fld, "samples"), L.MAX_KEYFRAMES)
-    rows = [c.vector(r, f"{join_field(fld, 'samples')}[{i}]", 3, hi=L.MAX_EVENT_TIME_S)
-            for i, r in enumerate(rows_raw)]
-    _check_rows(c, rows, join_field(fld, "samples"))
+    rows = _timed_rows(c, m, fld, "samples")
     try:
         return TrackMotion(np.array(rows))
     except ValueError as exc:
