@@ -1,8 +1,9 @@
 """CPU time per planning call of st-bitstar, and its decisions, for two source trees back-to-back.
 
 Runs st-bitstar deterministically (``planning_delay=0.1, batches_per_plan=2, max_time_s=10``) on
-paper-1..3 (``--seeds`` seeds), the first ``--random`` scenarios of ``random_suite(0)`` and
-``gap_suite(0, n=--gaps)``, and records for every run its status, time to goal, executed
+paper-1..3 (``--seeds`` seeds), the first ``--random`` scenarios of ``random_suite(0)``,
+``gap_suite(0, n=--gaps)`` and ``--dynabarn`` of DynaBARN's medium and hard worlds (20-59, evenly
+spread; tracks announced, as in ``benchmarks/spacetime.py``), and records for every run its status, time to goal, executed
 trajectory and planned paths (a fingerprint), and the CPU time (``time.process_time``) of every
 planning call (``_replan``). With ``--trees A,B`` each repetition runs one worker process per
 tree, alternating, so that the load of the shared machine falls on both alike; it then tells
@@ -38,6 +39,15 @@ def _scenarios(args: argparse.Namespace) -> list[tuple[str, Any, list[int]]]:
     out = [("paper", load_scenario(f"paper-{n}"), seeds) for n in (1, 2, 3)]
     out += [("random", sc, [0]) for sc in random_suite(0)[: args.random]]
     out += [("gaps", sc, [0]) for sc in gap_suite(0, n=args.gaps)]
+    if args.dynabarn > 0:
+        from anyplan.experiments.dynabarn import load_worlds, world_to_scenario
+        from anyplan.world.scenario import scenario_from_dict
+
+        worlds = load_worlds(args.worlds_file)
+        for i in np.linspace(20, 59, args.dynabarn).round().astype(int):
+            d = world_to_scenario(worlds[int(i)])
+            sc = d if not isinstance(d, dict) else scenario_from_dict(d, f"<dynabarn {i}>")
+            out.append(("dynabarn", sc, [0]))
     return out
 
 
@@ -94,7 +104,7 @@ def driver(args: argparse.Namespace) -> int:
     trees = [os.path.abspath(t) for t in args.trees.split(",")]
     results: dict[str, list[dict[str, Any]]] = {t: [] for t in trees}
     flags = ["--seeds", str(args.seeds), "--random", str(args.random), "--gaps", str(args.gaps),
-             "--mode", args.mode]
+             "--dynabarn", str(args.dynabarn), "--worlds-file", args.worlds_file, "--mode", args.mode]
     for rep in range(args.reps):
         for t in trees:
             env = dict(os.environ, PYTHONPATH=os.path.join(t, "src"))
@@ -123,12 +133,14 @@ def driver(args: argparse.Namespace) -> int:
     print("| suite | calls | " + " | ".join(f"{os.path.basename(t)} med / p95" for t in trees)
           + " | ratio med | ratio p95 |")
     print("|---|---|" + "---|" * len(trees) + "---|---|")
-    for suite in ("paper", "random", "gaps", "all"):
+    for suite in ("paper", "random", "gaps", "dynabarn", "all"):
         per = []
         for t in trees:
             x = [c for rep in results[t] for r in rep["runs"]
                  if suite in ("all", r["suite"]) for c in r["cpu_s"]]
             per.append((len(x), *_stats(x)))
+        if not per[0][0]:
+            continue
         cells = " | ".join(f"{m:.1f} / {p:.1f}" for _, m, p in per)
         rm, rp = per[-1][1] / per[0][1], per[-1][2] / per[0][2]
         print(f"| {suite} | {per[0][0]} | {cells} | {rm:.2f} | {rp:.2f} |")
@@ -150,6 +162,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--random", type=int, default=6)
     ap.add_argument("--gaps", type=int, default=6)
+    ap.add_argument("--dynabarn", type=int, default=0, help="DynaBARN worlds of 20-59 (default 0)")
+    ap.add_argument("--worlds-file", default="/work/shared/benchmarks/dynabarn/worlds.json")
     ap.add_argument("--mode", choices=("deterministic", "bench"), default="deterministic",
                     help="deterministic (batch budget: decisions compared) or bench (the "
                     "benchmark's time budget: decisions may differ with the load; timing only)")

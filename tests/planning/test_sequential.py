@@ -124,6 +124,37 @@ def test_a_batch_budget_gives_up_on_an_unreachable_goal_by_work_not_time():
     assert max(t for _, t in out) < 10.0
 
 
+@pytest.mark.parametrize("gap", [False, True])
+def test_prove_blocked_ends_a_detour_search_that_cannot_succeed(gap):
+    # A wall across paper-1, with a 0.8 m gap or none. A detour search (not the first plan)
+    # with prove_blocked stops after its ordinary budget (2 batches) when the wall provably
+    # separates start and goal, where it otherwise searches 20 x longer; with the gap it finds
+    # the path all the same.
+    from anyplan.planning.bitstar import BITStar
+    from anyplan.planning.problem import Problem
+
+    sc = load_scenario("paper-1")
+    wall = ([rectangle((10.0, 3.05), (0.4, 6.1)), rectangle((10.0, 8.95), (0.4, 4.1))] if gap
+            else [rectangle((10.0, 5.5), (0.4, 11.0))])
+    obst = sc.obstacle_set().with_shapes(wall)
+    spec = sc.robot
+    batches = {}
+    for prove in (False, True):
+        cfg = SequentialConfig(batches_per_plan=2, prove_blocked=prove)
+        loop = SequentialBITStar(obst, robot_radius=spec.radius, plan_radius=spec.radius + 0.03,
+                                 config=cfg, rng=np.random.default_rng(0))
+        problem = Problem.create(obst, spec.start[:2], spec.goal, spec.radius + 0.03)
+        planner = BITStar(problem, cfg.bitstar, rng=loop.rng)
+        loop._solve(planner, first=False)
+        res = planner.result()
+        assert res.solved == gap
+        if gap:
+            assert problem.path_valid(res.path)
+        batches[prove] = planner.n_batches
+    if not gap:
+        assert batches[True] <= 3 < 2 * 20 <= batches[False]
+
+
 def test_obstacle_parked_on_the_goal_makes_the_robot_wait_or_report():
     sc = load_scenario("paper-1")
     spec = sc.robot

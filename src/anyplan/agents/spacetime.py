@@ -36,7 +36,8 @@ from anyplan.world.scenario import Scenario
 
 __all__ = ["SpaceTimeBITStarAgent"]
 
-_DEFAULT_LOOP = SequentialConfig(max_iterations=8, wait_delays_s=(), max_time_s=0.3, anchor="obstacle")
+_DEFAULT_LOOP = SequentialConfig(max_iterations=8, wait_delays_s=(), max_time_s=0.3, anchor="obstacle",
+                                 prove_blocked=True)
 _LOOP_FIELDS = frozenset(f.name for f in dataclasses.fields(SequentialConfig))
 _WARM = False
 #: How far ahead [s] a motion in use is checked (a hold lasts "for ever").

@@ -18,6 +18,7 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any, Protocol
 
 import numpy as np
@@ -26,6 +27,7 @@ from anyplan.config import setting, validate
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.geometry.shapes import Shape, square
 from anyplan.planning.bitstar import BITStar, BITStarConfig
+from anyplan.planning.connectivity import provably_disconnected
 from anyplan.planning.problem import Problem
 from anyplan.planning.termination import any_of, batches, first_solution, timed
 from anyplan.prediction.base import PredictedObstacle
@@ -72,6 +74,10 @@ class SequentialConfig:
         max_time_s: Wall-clock cap [s] on the iterations of one replanning; the waiting
             search that may follow has the same cap again. A replanning that runs out of time
             returns its best effort (the motion whose first collision is latest).
+        prove_blocked: A detour search (after a square) that has no solution after its
+            ordinary budget stops at once when the squares provably disconnect start and goal
+            (:func:`~anyplan.planning.connectivity.provably_disconnected`), instead of going on
+            for up to 20 budgets in vain; the answer (no path) is the same.
         prediction_dt: The motion is resampled every ``prediction_dt`` seconds for the
             collision prediction (certified: the contact distance is enlarged by the
             interpolation error bound, at most v_max * prediction_dt / 2); None predicts on the
@@ -94,6 +100,7 @@ class SequentialConfig:
     prediction_dt: float | None = setting(0.02, lo=0.0, lo_open=True, unit="s",
                                           doc="resampling step of the prediction; None: exact")
     max_time_s: float = setting(0.5, lo=0.0, lo_open=True, unit="s", doc="wall-clock cap of a replanning")
+    prove_blocked: bool = setting(False, doc="skip detour searches that provably cannot succeed")
     bitstar: BITStarConfig = field(default_factory=BITStarConfig)
 
     def __post_init__(self) -> None:
@@ -120,9 +127,9 @@ class VirtualObstacle:
     obstacle: str
     shrunk: bool = False
 
-    @property
+    @cached_property
     def shape(self) -> Shape:
-        """The square as a polygon."""
+        """The square as a polygon (built once: the loop asks for it at every iteration)."""
         return square(self.center, self.side)
 
     def to_dict(self) -> dict[str, Any]:
@@ -243,6 +250,28 @@ class SequentialBITStar:
         # At least a first solution: keep searching (up to 20 budgets) until one exists.
         return any_of(timed(budget) & first_solution(), timed(20.0 * budget))
 
+    def _solve(self, planner: BITStar, first: bool) -> None:
+        """One BIT* search on its budget; with ``prove_blocked``, a detour search first gets
+        only its ordinary budget and goes on only if start and goal may still be connected
+        (the same stopping points as :meth:`_budget` otherwise)."""
+        cfg = self.config
+        if first or not cfg.prove_blocked:
+            planner.solve(self._budget(first))
+            return
+        if cfg.batches_per_plan is not None:
+            n = cfg.batches_per_plan
+            probe, rest = batches(n), any_of(first_solution(), batches(19 * n), timed(10.0))
+        else:
+            b = cfg.iteration_budget_s
+            probe, rest = timed(b), any_of(first_solution(), timed(19.0 * b))
+        planner.solve(probe)
+        if planner.result().solved:
+            return
+        p = planner.problem
+        if provably_disconnected(p.obstacles, p.start, p.goal, p.radius):
+            return
+        planner.solve(rest)
+
     def replan(self, start: np.ndarray, goal: np.ndarray, predictions: Sequence[PredictedObstacle],
                t_now: float, motion: MotionModel | None = None) -> SequentialResult:
         """Plan from ``start`` to ``goal`` until the predicted motion is collision-free.
@@ -283,7 +312,7 @@ class SequentialBITStar:
             if not cfg.warm_start and it > 0:
                 planner = BITStar(problem.with_shapes([s.shape for s in squares]), cfg.bitstar,
                                   rng=self.rng)
-            planner.solve(self._budget(it == 0))
+            self._solve(planner, it == 0)
             res = planner.result()
             plan_time += time.perf_counter() - t0
             if not res.solved:

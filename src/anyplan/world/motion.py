@@ -143,6 +143,12 @@ class UnicycleMotion(Motion):
         return np.array([self.x0 - r * math.sin(self.theta0), self.y0 + r * math.cos(self.theta0)])
 
 
+def _track_speed(k: np.ndarray) -> float:
+    """Largest speed [m/s] of a piecewise-linear track, rows (t, x, y)."""
+    seg = np.hypot(np.diff(k[:, 1]), np.diff(k[:, 2])) / np.diff(k[:, 0])
+    return float(seg.max())
+
+
 @dataclass(frozen=True)
 class WaypointMotion(Motion):
     """A looping piecewise-linear track: ``keyframes`` rows (t [s], x [m], y [m]).
@@ -162,6 +168,7 @@ class WaypointMotion(Motion):
             raise ValueError("keyframe times must start at 0 and increase strictly")
         k.setflags(write=False)
         object.__setattr__(self, "keyframes", k)
+        object.__setattr__(self, "_vmax", _track_speed(k))  # asked for by every prediction check
 
     @property
     def period(self) -> float:
@@ -170,9 +177,7 @@ class WaypointMotion(Motion):
 
     @property
     def max_speed(self) -> float:  # type: ignore[override]
-        k = self.keyframes
-        seg = np.hypot(np.diff(k[:, 1]), np.diff(k[:, 2])) / np.diff(k[:, 0])
-        return float(seg.max())
+        return self._vmax  # type: ignore[attr-defined]  # set in __post_init__ (frozen)
 
     @property
     def is_open(self) -> bool:
@@ -225,12 +230,11 @@ class TrackMotion(Motion):
         k.setflags(write=False)
         object.__setattr__(self, "samples", k)
         object.__setattr__(self, "span", (float(k[0, 0]), float(k[-1, 0])))
+        object.__setattr__(self, "_vmax", _track_speed(k))
 
     @property
     def max_speed(self) -> float:  # type: ignore[override]
-        k = self.samples
-        seg = np.hypot(np.diff(k[:, 1]), np.diff(k[:, 2])) / np.diff(k[:, 0])
-        return float(seg.max())
+        return self._vmax  # type: ignore[attr-defined]  # set in __post_init__ (frozen)
 
     def positions(self, t: np.ndarray) -> np.ndarray:
         tt = np.asarray(t, dtype=float)
