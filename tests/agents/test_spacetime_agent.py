@@ -127,3 +127,26 @@ def test_holds_and_records_a_fallback_when_nothing_is_safe():
     # The robot never drove towards the obstacle: it is hit while at rest (not robot-caused).
     tr = r.trajectory_array
     assert np.max(np.abs(tr[:, 4])) < 0.05
+
+
+def test_planning_predictions_of_uncertain_obstacles():
+    # With predictions extrapolated from the twist (a horizon), st-bitstar plans against: none
+    # out of reach before the horizon; a disc that already holds the robot shrunk to leave it
+    # just outside (so leaving it is not a collision at t = 0). Announced motions: untouched.
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.prediction.base import RadiusGrowth
+    from anyplan.world import UnicycleMotion
+
+    agent = make_agent("st-bitstar")
+    agent.reset(_crossing_scenario(), np.random.default_rng(0))
+    p, t = np.array([1.0, 3.0]), 0.0
+    growth = RadiusGrowth(0.0, np.array([0.0, 1.0, 3.0]), np.array([0.1, 0.4, 1.0]))
+    near = PredictedObstacle("near", 0.25, UnicycleMotion(1.6, 3.0, 0.0, 0.5), growth, until=3.0)
+    far = PredictedObstacle("far", 0.25, UnicycleMotion(11.0, 5.0, math.pi, 1.0), growth, until=3.0)
+    kept = agent._planning_preds([near, far], p, t)
+    assert [o.name for o in kept] == ["near"]
+    gap = math.hypot(*(near.positions(np.array([t]))[0] - p)) - 0.3 - agent.config.margin
+    assert gap - float(kept[0].radius_at(t)) == pytest.approx(0.02)
+    assert kept[0].radius_at(2.0) > kept[0].radius_at(t)  # still grows with the horizon
+    announced = [PredictedObstacle("near", 0.25, near.motion)]
+    assert agent._planning_preds(announced, p, t) is announced

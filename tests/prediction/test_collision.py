@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -126,3 +127,34 @@ def test_unicycle_positions_are_the_chord_formula_bit_for_bit():
                                m.y0 + chord * np.sin(m.theta0 + half)])
         assert np.array_equal(m.positions(t), ref)
         assert np.array_equal(m.positions(float(t[0])), ref[:1])
+
+
+def test_a_prediction_with_a_horizon_is_checked_up_to_it_only():
+    # A walker crossing the robot's line where the robot passes (x = 7.5 m); the same prediction
+    # ending (until) before the contact predicts none, one ending after it the same contact.
+    motion = _motion(5.0)
+    t = np.linspace(motion.t_start, motion.t_end, 2001)
+    t_pass = float(t[np.argmin(np.abs(motion.positions(t)[:, 0] - 7.5))])
+    walker = UnicycleMotion(7.5, 5.0 + 0.6 * t_pass, -np.pi / 2, 0.6)
+    full = PredictedObstacle("w", 0.3, walker)
+    hit = first_collision(motion, [full], SPEC.radius)
+    assert hit is not None
+    early = PredictedObstacle("w", 0.3, walker, until=hit.t - 0.5)
+    late = PredictedObstacle("w", 0.3, walker, until=hit.t + 0.5)
+    assert first_collision(motion, [early], SPEC.radius) is None
+    assert first_collision(motion, [late], SPEC.radius).t == pytest.approx(hit.t, abs=1e-3)
+    assert early.radius_at(hit.t) == -np.inf and early.radius_at(hit.t - 1.0) == 0.3
+    assert np.all(early.radius_at(np.array([0.0, hit.t])) == np.array([0.3, -np.inf]))
+
+
+def test_horizon_only_for_extrapolated_predictions():
+    from anyplan.prediction import ConstantTwistPredictor, ObstacleObservation
+
+    walker = UnicycleMotion(7.5, 9.0, -np.pi / 2, 0.6)
+    seen = ObstacleObservation("a", 2.0, 7.5, 9.0, -np.pi / 2, 0.6, 0.0, 0.3)
+    announced = ObstacleObservation("b", 2.0, 7.5, 9.0, -np.pi / 2, 0.6, 0.0, 0.3, walker)
+    a, b = ConstantTwistPredictor(horizon_s=3.0).predict([seen, announced])
+    assert a.until == pytest.approx(5.0) and b.until == np.inf
+    assert ConstantTwistPredictor().predict([seen])[0].until == np.inf
+    with pytest.raises(ValueError, match="horizon_s"):
+        ConstantTwistPredictor(horizon_s=0.0)

@@ -238,14 +238,36 @@ class SafetyGuard:
         best = math.inf
         r = self.spec.radius
         p0 = motion.positions(np.array([t0]))[0]
+        # Branch and bound on samples: an obstacle whose certified lower bound on the sampled
+        # grid (distance on [t_i, t_i+1] >= (d_i + d_i+1 - L dt) / 2) exceeds another's sampled
+        # minimum (an upper bound on its own) cannot be the nearest: it is not searched.
+        ts = np.linspace(t0, t1, max(2, int(math.ceil((t1 - t0) / 0.1)) + 1))
+        pm = motion.positions(ts)
+        bounds = []
         for o in preds:
+            t1o = min(t1, float(getattr(o, "until", math.inf)))
+            if t1o < t0:
+                bounds.append((math.inf, math.inf))
+                continue
+            d = np.hypot(*(pm - o.positions(ts)).T) - _max_radius(o) - r
+            d[ts > t1o + 0.1] = math.inf
+            lb = 0.5 * (d[:-1] + d[1:] - (float(motion.max_speed) + float(o.max_speed)) * np.diff(ts))
+            bounds.append((float(lb.min()), float(d.min())))
+        cutoff = min((b[1] for b in bounds), default=math.inf)
+        for o, (lo, _) in zip(preds, bounds, strict=True):
+            if lo > cutoff + 1e-6:
+                continue
+            t1o = min(t1, float(getattr(o, "until", math.inf)))  # up to the prediction's horizon
+            if t1o < t0:
+                continue
             q0 = o.positions(np.array([t0]))[0]
             speed = float(motion.max_speed) + float(o.max_speed)
             ro = _max_radius(o)
-            lb = math.hypot(*(p0 - q0)) - speed * (t1 - t0) - r - ro
+            lb = math.hypot(*(p0 - q0)) - speed * (t1o - t0) - r - ro
             if lb >= best:
                 continue  # cannot come closer than the best so far
-            _, d = closest_approach(motion.positions, o.positions, speed, t0, t1, tol=self.config.tol)
+            _, d = closest_approach(motion.positions, o.positions, speed, t0, t1o,
+                                    tol=self.config.tol)
             best = min(best, d - r - ro)
         return best
 
@@ -270,6 +292,7 @@ class SafetyGuard:
         best, u = math.inf, None
         for o in preds:
             d = np.hypot(*(pr - o.positions(ts)).T) - _max_radius(o)
+            d[ts > float(getattr(o, "until", math.inf))] = math.inf
             k = int(np.argmin(d))
             if d[k] < best:
                 best = float(d[k])

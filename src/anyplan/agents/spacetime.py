@@ -16,6 +16,7 @@ timing policy is :class:`~anyplan.agents.replanning.ReplanningAgent`'s, shared w
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from collections.abc import Sequence
 from typing import Any
@@ -27,7 +28,7 @@ from anyplan.agents.sequential import SequentialBITStarAgent
 from anyplan.agents.stats import SpaceTimeStats
 from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import MotionModel, SequentialConfig, SequentialResult
-from anyplan.prediction.base import PredictedObstacle
+from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle, RadiusGrowth
 from anyplan.trajectory.kinds import ST_PREFIX, MotionKind
 from anyplan.trajectory.spacetime import retime, verify
 from anyplan.trajectory.trajectory import Trajectory
@@ -42,6 +43,12 @@ _LOOP_FIELDS = frozenset(f.name for f in dataclasses.fields(SequentialConfig))
 _WARM = False
 #: How far ahead [s] a motion in use is checked (a hold lasts "for ever").
 _CHECK_HORIZON_S = 60.0
+#: Gap [m] a predicted disc that already holds the robot is shrunk to (``_planning_preds``).
+_INSIDE_GAP_M = 0.02
+
+
+def _finite(x: float | None) -> float | None:
+    return None if x is None or not math.isfinite(x) else float(x)
 
 
 def warm_up_spacetime() -> None:
@@ -92,6 +99,12 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         max_wait_s: When no path can be timed within ``patience_s``, the first and the last
             path are timed again with delays up to this much [s], and the earlier arrival wins.
         lattice_dt_s: Approximate step [s] of the velocity lattice.
+        horizon_s: Horizon [s] of a prediction extrapolated from the current twist (perception
+            ``twist`` or ``tracked``: no announced motion); beyond it the obstacle is not checked
+            (receding horizon, see :meth:`_planning_preds`). None: predictions never end.
+        plan_extra_m: With such predictions, paths are planned and timed against discs whose
+            extra radius is capped at this [m]; the safety guard checks every motion against
+            the full growth (free to rest, or stoppable) before it starts. None: no cap.
         **kwargs: Further options of :class:`SequentialBITStarAgent` (planning_delay, ...).
     """
 
@@ -101,6 +114,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
 
     def __init__(self, config: SequentialConfig | None = None, *, patience_s: float = 3.0,
                  max_wait_s: float = 30.0, lattice_dt_s: float = 0.25, accept_s: float = 0.5,
+                 horizon_s: float | None = 3.0, plan_extra_m: float | None = 0.3,
                  **kwargs: Any) -> None:
         loop = {k: kwargs.pop(k) for k in list(kwargs) if k in _LOOP_FIELDS}  # e.g. from --set
         if config is None:
@@ -112,6 +126,13 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                           ("lattice_dt_s", lattice_dt_s)):
             if not (isinstance(val, int | float) and val > 0.0):
                 raise ValueError(f"{name}: must be > 0, got {val!r}")
+        if horizon_s is not None and not (isinstance(horizon_s, int | float) and horizon_s > 0.0):
+            raise ValueError(f"horizon_s: must be > 0 or null, got {horizon_s!r}")
+        self.horizon_s = None if horizon_s is None else float(horizon_s)
+        if plan_extra_m is not None and not (isinstance(plan_extra_m, int | float)
+                                             and plan_extra_m >= 0.0):
+            raise ValueError(f"plan_extra_m: must be >= 0 or null, got {plan_extra_m!r}")
+        self.plan_extra_m = None if plan_extra_m is None else float(plan_extra_m)
         if not (isinstance(accept_s, int | float) and 0.0 <= accept_s <= patience_s):
             raise ValueError(f"accept_s: must be in [0, patience_s], got {accept_s!r}")
         self.accept_s = float(accept_s)
@@ -122,6 +143,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
         warm_up_spacetime()
         super().reset(scenario, rng)
+        self.predictor = ConstantTwistPredictor(horizon_s=self.horizon_s)
         self._cands: list[tuple[float, Trajectory, np.ndarray, list[Shape]]] = []
         self._tried: list[tuple[np.ndarray, list[Shape]]] = []
         self._path: np.ndarray | None = None
@@ -178,6 +200,68 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         i = int(np.searchsorted(plan.s, s_in))
         return max(0.0, float(plan.t[-1] - plan.t[min(i, len(plan.t) - 1)]))
 
+    def _planning_preds(self, preds: list[PredictedObstacle], p: np.ndarray,
+                        t: float) -> list[PredictedObstacle]:
+        """The predictions planned against from the robot's position ``p`` at ``t`` [s].
+
+        Unchanged unless some prediction has a horizon (``until``: no announced motion). Then
+        (1) a prediction that cannot come within reach of the robot before its horizon (both at
+        their top speeds) is left out, and (2) a predicted disc that already holds the robot at
+        ``t`` is shrunk to leave it just outside (by ``_INSIDE_GAP_M``): being inside is not the
+        robot's doing, and a motion that leaves the disc must not look colliding at its start
+        (holding still, or going deeper, still does as the disc comes on or grows).
+        """
+        if not preds or all(o.until == math.inf for o in preds):
+            return preds  # the same object: certain predictions
+        r, v, m = self.spec.radius, self.spec.v_max, self.config.margin
+        out = []
+        for o in preds:
+            if o.until < t:
+                continue
+            q = o.positions(np.array([t]))[0]
+            d = float(np.hypot(*(q - p)))
+            if d - (v + o.max_speed) * (o.until - t) - r - m - o.max_radius > 0.0:
+                continue  # out of reach within the horizon
+            gap = d - r - m - float(o.radius_at(t))
+            if gap < _INSIDE_GAP_M:
+                cut = _INSIDE_GAP_M - gap
+                base = max(o.radius - cut, 0.0)
+                g = o.growth
+                if g is not None and cut > o.radius - base:
+                    g = RadiusGrowth(g.t0, g.taus, np.maximum(g.values - (cut - o.radius + base), 0.0))
+                o = PredictedObstacle(o.name, base, o.motion, g, o.until)
+                self.record.inside_discs = (self.record.inside_discs or 0) + 1
+            out.append(o)
+        return out
+
+    def _capped(self, preds: list[PredictedObstacle]) -> list[PredictedObstacle]:
+        """``preds`` with their extra radius capped at ``plan_extra_m`` (what paths are planned
+        and timed against; the safety guard keeps the full growth)."""
+        c = self.plan_extra_m
+        if c is None:
+            return preds
+        return [o if o.growth is None or o.growth.max_extra <= c else
+                PredictedObstacle(o.name, o.radius, o.motion,
+                                  RadiusGrowth(o.growth.t0, o.growth.taus,
+                                               np.minimum(o.growth.values, c)), o.until)
+                for o in preds]
+
+    def _guard(self, obs: Observation, t_switch: float, motion: Trajectory | None,
+               safe: list[PredictedObstacle], reason: str) -> tuple[str, Trajectory | None]:
+        """The safety invariant against the full uncertain predictions ``safe``: start
+        ``motion`` at ``t_switch`` [s] if it is free to rest or stoppable there, else keep the
+        current motion if it still is, else the guard's fallback of largest predicted clearance
+        (hold, brake, turn away, back off). Returns the decision's kind and trajectory."""
+        commit = self.check_period_s + max(t_switch - obs.t, 0.0)
+        state = self._state_at(obs, t_switch)
+        dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit)
+        if dec.kind in ("motion", "keep"):
+            return dec.kind, dec.trajectory
+        self.record.fallbacks.append(
+            {"t": float(obs.t), "kind": dec.kind, "reason": dec.reason or reason,
+             "predicted_clearance_m": _finite(dec.predicted_clearance_m)})
+        return dec.kind, dec.trajectory
+
     def _fallback(self, obs: Observation, t_switch: float, preds: list[PredictedObstacle],
                   reason: str) -> Trajectory:
         """Brake to rest on the current reference (or stay) and hold."""
@@ -194,6 +278,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
         dt, d, t_ready, state = self._begin_replan(obs)
         t = obs.t
+        safe = self._planning_preds(preds, np.array([state.x, state.y]), t_ready)
+        uncertain = safe is not preds
+        preds = self._capped(safe) if uncertain else preds
         self._cands = []
         self._tried = []
         self._preds = list(preds)
@@ -232,6 +319,14 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         # really have, on the same path (no new search).
         t_switch, motion = self._take_up(obs, t_ready, wall, d, dt, motion,
                                          lambda state, t_s: self._retime_path(state, t_s, path, shapes))
+        if uncertain:
+            kind, motion = self._guard(obs, t_switch, motion, safe, res.status)
+            if kind == "keep":
+                return
+            if kind != "motion":
+                self._fallback_active = True
+                self.pending = (t_switch, motion)  # type: ignore[assignment]
+                return
         if motion is None:
             if self.trajectory is not None and verify(
                     self.trajectory, preds, self.spec.radius, t_from=t_switch,
@@ -239,6 +334,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 return  # the current reference is still free: keep it, try again later
             motion = self._fallback(obs, t_switch, preds, res.status)
         else:
+            self._fallback_active = False
             self._path, self._shapes = np.asarray(path), list(shapes)
             self.record.st_timed += int(motion.kind.startswith(ST_PREFIX))
             self.record.st_waits_s.append(float(motion.info.get("wait_s", 0.0)))
@@ -259,15 +355,29 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
 
     def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
         t = obs.t
+        if self._requested is not None and t - self._last_replan >= self.check_period_s - 1e-9:
+            # e.g. an obstacle left its predicted tube (at most one replanning a check period)
+            reason, self._requested = self._requested, None
+            self._observe_check(obs, preds)
+            if not self._arrived(obs, self.trajectory):  # type: ignore[arg-type]
+                self._replan(obs, preds, reason)
+            return
         new = self._observe_check(obs, preds)
         traj = self.trajectory
         assert traj is not None
         spec = self.spec
         if self._arrived(obs, traj):
             return
-        if traj.kind == MotionKind.FALLBACK_HOLD and t - self._last_replan >= self.min_replan_interval_s:
+        if ((traj.kind == MotionKind.FALLBACK_HOLD or self._fallback_active)
+                and t - self._last_replan >= self.min_replan_interval_s):
             self._replan(obs, preds, "holding")
             return
+        safe = self._planning_preds(preds, np.array([obs.robot.x, obs.robot.y]), t)
+        if safe is not preds:
+            preds = self._capped(safe)
+            if not self.guard.still_safe(traj, safe, t, self.check_period_s + 0.1):
+                self._replan(obs, preds, "safety: the motion in use can no longer stop in time")
+                return
         hit = verify(traj, preds, spec.radius, t_from=t,
                      t_until=min(max(traj.t_end, t) + 1.0, t + _CHECK_HORIZON_S),
                      margin=0.5 * self.config.margin)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
@@ -89,19 +90,28 @@ class PredictedObstacle:
 
     With ``growth``, the disc's radius at time t is ``radius + growth.at(t)`` (an uncertain
     prediction whose disc grows with the horizon, up to a cap); the certified collision checks
-    (:mod:`anyplan.prediction.collision`) honour it exactly.
+    (:mod:`anyplan.prediction.collision`) honour it exactly. ``until`` [s] is the prediction's
+    horizon: after it the obstacle is not predicted at all (no disc; ``radius_at`` is -inf), so
+    the checks end there for it (a receding-horizon planner replans before it).
     """
 
     name: str
     radius: float
     motion: Motion
     growth: RadiusGrowth | None = None
+    until: float = math.inf
 
     def radius_at(self, t: np.ndarray | float) -> np.ndarray | float:
-        """Disc radius [m] at absolute times ``t`` [s]."""
+        """Disc radius [m] at absolute times ``t`` [s] (-inf after :attr:`until`)."""
         if self.growth is None:
-            return self.radius if np.ndim(t) == 0 else np.full(np.shape(t), self.radius)
-        return self.radius + self.growth.at(t)
+            r = self.radius if np.ndim(t) == 0 else np.full(np.shape(t), self.radius)
+        else:
+            r = self.radius + self.growth.at(t)
+        if self.until == math.inf:
+            return r
+        if np.ndim(t) == 0:
+            return r if float(t) <= self.until else -math.inf
+        return np.where(np.asarray(t, dtype=float) <= self.until, r, -math.inf)
 
     @property
     def max_radius(self) -> float:
@@ -131,21 +141,29 @@ class ConstantTwistPredictor:
 
     This is exact for the paper's obstacles, whose motion has constant v and omega. When an
     observation carries a full motion model (``observation.motion``) and ``use_announced`` is
-    True, that model is used instead.
+    True, that model is used instead. With ``horizon_s``, a prediction extrapolated from the
+    current twist (no announced motion) ends ``horizon_s`` seconds after its observation
+    (:attr:`PredictedObstacle.until`); announced motions are kept in full.
     """
 
-    def __init__(self, use_announced: bool = True) -> None:
+    def __init__(self, use_announced: bool = True, horizon_s: float | None = None) -> None:
+        if horizon_s is not None and not horizon_s > 0.0:
+            raise ValueError(f"horizon_s: must be > 0 or None, got {horizon_s!r}")
         self.use_announced = use_announced
+        self.horizon_s = horizon_s
 
     def predict(self, observations: Sequence[ObstacleObservation]) -> list[PredictedObstacle]:
         """Predicted motions, with times measured on the same clock as the observations."""
         out = []
         for o in observations:
+            until = math.inf
             if self.use_announced and o.motion is not None:
                 motion: Motion = o.motion
             else:
                 motion = _shifted_unicycle(o)
-            out.append(PredictedObstacle(o.name, o.radius, motion, o.growth))
+                if self.horizon_s is not None:
+                    until = o.t + self.horizon_s
+            out.append(PredictedObstacle(o.name, o.radius, motion, o.growth, until))
         return out
 
 

@@ -9,7 +9,8 @@ speed so that no contact can slip between evaluation points: the time returned i
 ``tol`` and never later than the true first contact. An obstacle whose radius grows with the
 horizon (``PredictedObstacle.growth``, an uncertain prediction) is searched with its growing
 radius and the growth rate added to the speed bound
-(:func:`anyplan.geometry.moving.first_contact_growing`): exact for the growing disc too.
+(:func:`anyplan.geometry.moving.first_contact_growing`): exact for the growing disc too. A
+prediction with a horizon (``PredictedObstacle.until``) is checked up to it only.
 """
 
 from __future__ import annotations
@@ -173,6 +174,8 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
     vr = float(motion.max_speed)
     starts: list[tuple[float, int]] = []
     for k, o in enumerate(obstacles):
+        if o.until < t0:
+            continue  # predicted only before the interval
         reach = robot_radius + o.radius + margin + extra
         d = np.hypot(*(p - o.positions(grid)).T)
         rate = 0.0
@@ -181,6 +184,8 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
             rate = o.growth.rate
         lb = 0.5 * (d[:-1] + d[1:] - (vr + o.max_speed + rate) * np.diff(grid))
         bad = np.flatnonzero(lb <= reach)
+        if o.until < t1:  # intervals that start after the prediction's horizon do not count
+            bad = bad[grid[bad] <= o.until]
         if len(bad):
             starts.append((float(grid[bad[0]]), k))
     starts.sort()
@@ -189,11 +194,13 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
             break  # no later candidate can come before the contact already found
         o = obstacles[k]
         reach = robot_radius + o.radius + margin + extra
+        t1o = min(t1, o.until)
         if o.growth is None:
-            tc = first_contact(motion.positions, o.positions, vr + o.max_speed, reach, ts, t1, tol=tol)
+            tc = first_contact(motion.positions, o.positions, vr + o.max_speed, reach, ts, t1o,
+                               tol=tol)
         else:
             tc = first_contact_growing(motion.positions, o.positions, vr + o.max_speed, reach,
-                                       o.growth.at, o.growth.rate, ts, t1, tol=tol)
+                                       o.growth.at, o.growth.rate, ts, t1o, tol=tol)
         if tc is None:
             continue
         ta = np.array([tc])
