@@ -28,6 +28,16 @@ print(matplotlib.get_backend().lower())
 """
 
 
+CLI_LATE = """
+import sys
+from anyplan.cli.main import main
+main(["scenarios"])
+assert "matplotlib" not in sys.modules  # a command that does not draw never imports it
+import matplotlib
+print(matplotlib.get_backend().lower())
+"""
+
+
 def _run(code: str, **env: str) -> str:
     e = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}
     e.update(env)
@@ -43,3 +53,8 @@ def test_importing_every_viz_module_keeps_the_backend():
 def test_the_command_line_picks_agg_only_when_none_was_chosen():
     assert _run(CLI) == "agg"
     assert _run(CLI, MPLBACKEND="svg") == "svg"
+
+
+def test_the_command_line_imports_matplotlib_only_to_draw_and_then_picks_agg():
+    assert _run(CLI_LATE) == "agg"
+    assert _run(CLI_LATE, MPLBACKEND="svg") == "svg"
