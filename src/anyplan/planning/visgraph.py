@@ -373,8 +373,9 @@ def _edges(px: np.ndarray, py: np.ndarray, prv: np.ndarray, nxt: np.ndarray, n_f
                 cap *= 2
                 ei2 = np.empty(cap, np.int64)
                 ej2 = np.empty(cap, np.int64)
-                ei2[:m] = ei[:m]
-                ej2[:m] = ej[:m]
+                for q in range(m):  # not a slice copy: that compiles numba's error formatting
+                    ei2[q] = ei[q]
+                    ej2[q] = ej[q]
                 ei = ei2
                 ej = ej2
             ei[m] = i
