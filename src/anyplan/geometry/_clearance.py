@@ -2,10 +2,11 @@
 
 Every kernel takes the obstacle set as one record, :class:`ObstacleArrays` (defined here beside
 its kernels, public as ``anyplan.geometry.collision.ObstacleArrays``; it documents the layout), and
-plain floats, so numba compiles it once and caches the machine code (``cache=True``). The
-public entry points for other packages' compiled code are re-exported by
-:mod:`anyplan.geometry.collision` (``segment_clearance_kernel``, ``segment_blocked_kernel``);
-Python code uses :class:`~anyplan.geometry.collision.ObstacleSet`.
+plain floats, so numba compiles it once and caches the machine code (``cache=True``). Flags are
+passed as ``np.bool_(True)``, not ``True``: numba types a constant argument as a literal and would
+compile one specialisation per value. The public entry points for other packages' compiled code
+are re-exported by :mod:`anyplan.geometry.collision` (``segment_clearance_kernel``,
+``segment_blocked_kernel``); Python code uses :class:`~anyplan.geometry.collision.ObstacleSet`.
 
 A query against the grid index is exact: it scans the cells within a distance R of the query
 (a conservative, padded cover of the capsule), and R grows until the best distance found is
@@ -328,7 +329,7 @@ def point_clearance(px: float, py: float, obs: ObstacleArrays) -> float:
                 best = math.sqrt(d2)
             j = i
     if gmeta[3] > 0.0:
-        best = _grid_clearance(px, py, px, py, best, 0.0, True, obs)
+        best = _grid_clearance(px, py, px, py, best, 0.0, np.bool_(True), obs)
     return best
 
 
@@ -398,7 +399,7 @@ def segment_clearance(ax: float, ay: float, bx: float, by: float, obs: ObstacleA
     Returns early, with some value below ``stop_below``, as soon as the clearance is known to
     be smaller than ``stop_below`` (pass ``-1`` for the exact minimum); otherwise exact.
     """
-    return _segment_clearance(ax, ay, bx, by, obs, stop_below, True)
+    return _segment_clearance(ax, ay, bx, by, obs, stop_below, np.bool_(True))
 
 
 @njit(cache=True)
@@ -406,7 +407,7 @@ def segment_blocked(ax: float, ay: float, bx: float, by: float, obs: ObstacleArr
                     limit: float) -> bool:
     """True iff the exact clearance of segment ab is < ``limit`` [m] (pass/fail only: on a map
     it scans only the cells within ``limit`` of the segment)."""
-    return _segment_clearance(ax, ay, bx, by, obs, limit, False) < limit
+    return _segment_clearance(ax, ay, bx, by, obs, limit, np.bool_(False)) < limit
 
 
 @njit(cache=True)
@@ -423,7 +424,7 @@ def points_clear(px: np.ndarray, py: np.ndarray, obs: ObstacleArrays, limit: flo
     """Mask (N,): the exact clearance of each point is >= ``limit`` [m] (pass/fail only)."""
     out = np.empty(px.shape[0], dtype=np.bool_)
     for n in range(px.shape[0]):
-        out[n] = _segment_clearance(px[n], py[n], px[n], py[n], obs, limit, False) >= limit
+        out[n] = _segment_clearance(px[n], py[n], px[n], py[n], obs, limit, np.bool_(False)) >= limit
     return out
 
 
