@@ -97,3 +97,21 @@ def test_many_obstacle_scenarios_are_seeded_and_valid():
             p = o.position(float(t))
             assert x0 <= p[0] <= x1 and y0 <= p[1] <= y1
         assert np.hypot(*(o.position(0.0) - np.array(a.robot.start[:2]))) >= 2.0
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_flood_fill_agrees_with_connected_component_labelling(seed):
+    # The compiled 8-connected flood fill of provably_disconnected against scipy's labelling.
+    from scipy import ndimage
+
+    from anyplan.planning._connectivity_kernels import connected8
+
+    rng = np.random.default_rng(seed)
+    for _ in range(40):
+        ny, nx = rng.integers(1, 30, size=2)
+        grid = rng.random((ny, nx)) < rng.uniform(0.3, 0.8)
+        labels, _ = ndimage.label(grid, structure=np.ones((3, 3), dtype=int))
+        a = (int(rng.integers(ny)), int(rng.integers(nx)))
+        b = (int(rng.integers(ny)), int(rng.integers(nx)))
+        want = bool(labels[a] != 0 and labels[a] == labels[b])
+        assert connected8(grid, *a, *b) == want

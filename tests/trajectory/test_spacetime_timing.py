@@ -9,7 +9,7 @@ from anyplan.geometry.collision import ObstacleSet
 from anyplan.prediction.base import PredictedObstacle
 from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.motion import plan_motion
-from anyplan.trajectory.spacetime import build_stmap, retime, verify
+from anyplan.trajectory.spacetime import RowCache, build_stmap, retime, verify
 from anyplan.world.motion import UnicycleMotion
 from anyplan.world.robot import RobotSpec, RobotState
 
@@ -74,6 +74,40 @@ def test_stmap_is_conservative(seed):
         d = np.hypot(p[:, None, 0] - q[None, :, 0], p[:, None, 1] - q[None, :, 1])
         assert d.min() > reach
     assert m.forbidden.any()
+
+
+def _pts(s):
+    s = np.asarray(s, dtype=float)
+    return np.column_stack([1.0 + s, np.full(s.shape, 2.0)])
+
+
+def test_shared_rows_give_the_same_map_on_their_grid_and_a_conservative_one_off_it():
+    # Maps of several paths built with one RowCache: a map starting on the cache's grid is
+    # the map built without it; one starting between rows starts at the row
+    # before (rows of the grid) and is conservative over its whole span (dense samples).
+    ob = PredictedObstacle("X", 0.3, UnicycleMotion(5.0, -1.3, np.pi / 2, 0.3))
+    grow = Growing("G", UnicycleMotion(3.0, 5.0, -np.pi / 2, 0.2), 0.3, 0.02)
+    rows = RowCache(1.0, 0.05)
+    for length in (6.0, 8.0, 3.5):  # the cache grows to the longest horizon asked for
+        plain = build_stmap(_pts, length, [ob, grow], SPEC.radius, 1.25, 25.0, margin=0.05)
+        shared = build_stmap(_pts, length, [ob, grow], SPEC.radius, 1.25, 25.0, margin=0.05,
+                             rows=rows)
+        assert shared.t_map == plain.t_map
+        assert np.array_equal(shared.forbidden, plain.forbidden) and plain.forbidden.any()
+    off = build_stmap(_pts, 8.0, [ob, grow], SPEC.radius, 1.27, 25.0, margin=0.05, rows=rows)
+    assert off.t_map == pytest.approx(1.25) and off.t_map + off.horizon_s >= 1.27 + 25.0 - 1e-9
+    reach = SPEC.radius + 0.05
+    rng = np.random.default_rng(0)
+    free_rows, free_cells = np.nonzero(~off.forbidden)
+    pick = rng.choice(len(free_rows), size=3000, replace=False)
+    for j, c in zip(free_rows[pick], free_cells[pick], strict=True):
+        ts = off.t_map + np.linspace(j * off.h, (j + 1) * off.h, 6)
+        p = _pts(np.linspace(c * off.ds, min((c + 1) * off.ds, 8.0), 6))
+        for o in (ob, grow):
+            q = o.positions(ts)
+            d = np.hypot(p[:, None, 0] - q[None, :, 0], p[:, None, 1] - q[None, :, 1])
+            r = np.broadcast_to(np.asarray(o.radius_at(ts), dtype=float), ts.shape)
+            assert (d - r[None, :]).min() > reach
 
 
 def test_retimed_motion_passes_behind_and_is_certified_free():

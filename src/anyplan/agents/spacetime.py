@@ -30,7 +30,7 @@ from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import MotionModel, SequentialConfig, SequentialResult
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle, RadiusGrowth
 from anyplan.trajectory.kinds import ST_PREFIX, MotionKind
-from anyplan.trajectory.spacetime import retime, verify
+from anyplan.trajectory.spacetime import RowCache, retime, verify
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import RobotState
 from anyplan.world.scenario import Scenario
@@ -43,6 +43,8 @@ _LOOP_FIELDS = frozenset(f.name for f in dataclasses.fields(SequentialConfig))
 _WARM = False
 #: How far ahead [s] a motion in use is checked (a hold lasts "for ever").
 _CHECK_HORIZON_S = 60.0
+#: Row duration [s] of the s-t maps.
+_ROW_H = 0.05
 #: Gap [m] a predicted disc that already holds the robot is shrunk to (``_planning_preds``).
 _INSIDE_GAP_M = 0.02
 
@@ -58,6 +60,7 @@ def warm_up_spacetime() -> None:
         return
     _WARM = True
     from anyplan.geometry.collision import ObstacleSet
+    from anyplan.planning.connectivity import provably_disconnected
     from anyplan.trajectory.motion import plan_motion
     from anyplan.world.motion import UnicycleMotion
     from anyplan.world.robot import RobotSpec
@@ -69,6 +72,7 @@ def warm_up_spacetime() -> None:
     res = retime(tr, [mover], spec, max_wait_s=5.0)
     if res.trajectory is not None:
         verify(res.trajectory, [mover], spec.radius)
+    provably_disconnected(obs, (0.5, 0.5), (3.5, 0.5), spec.radius)  # the detours' proof
 
 
 def _remaining(path: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -149,6 +153,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         self._path: np.ndarray | None = None
         self._shapes: list[Shape] = []
         self._preds: list[PredictedObstacle] = []
+        self._rows: RowCache | None = None
 
     def _new_record(self) -> SpaceTimeStats:
         return SpaceTimeStats()
@@ -159,6 +164,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         candidates (``self._cands``)."""
         nominal_fn = self.reference.departing(state, t_start)
         spec, cfg = self.spec, self.config
+        if self._rows is None or self._rows.t_origin != t_start:
+            self._rows = RowCache(t_start, _ROW_H)  # the obstacles' s-t rows, for every candidate
 
         def build(path: np.ndarray, shapes: Sequence[Shape], delay: float) -> Trajectory:
             if delay == 0.0:
@@ -176,7 +183,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 self._cands.append((nominal.t_end, nominal, np.asarray(path), list(shapes)))
                 return nominal
             res = retime(nominal, self._preds, spec, margin=cfg.margin, max_wait_s=max_wait_s,
-                         target_dt=self.lattice_dt_s, free_tail_m=0.5 * spec.goal_tolerance)
+                         target_dt=self.lattice_dt_s, free_tail_m=0.5 * spec.goal_tolerance,
+                         rows=self._rows)
             tr = res.trajectory
             if tr is None:
                 return nominal
@@ -284,6 +292,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         self._cands = []
         self._tried = []
         self._preds = list(preds)
+        self._rows = None
         w0 = time.perf_counter()
         res: SequentialResult | None = None
         if self._path is not None and len(self._path) >= 2:

@@ -6,7 +6,7 @@ Cover the arena with square cells of side h. A cell whose centre has clearance b
 cells, each sharing at least a point with the next (8-neighbours). Hence, if the cells of the
 start and of the goal are not 8-connected through unblocked cells, no collision-free path
 exists: the answer ``True`` is a proof, ``False`` proves nothing. The cost is one pass/fail
-clearance query per cell and a connected-component labelling, whatever the number of obstacles,
+clearance query per cell and a compiled flood fill, whatever the number of obstacles,
 unlike the visibility graph's lower bound (quadratic in the obstacle corners).
 """
 
@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from anyplan.geometry.collision import ObstacleSet
+from anyplan.planning._connectivity_kernels import connected8
 
 __all__ = ["provably_disconnected"]
 
@@ -36,8 +37,6 @@ def provably_disconnected(obstacles: ObstacleSet, start: np.ndarray | tuple[floa
         radius: Robot radius [m], > 0.
         cell: Cell side [m]; default max(radius / 2, the side giving :data:`MAX_CELLS` cells).
     """
-    from scipy import ndimage
-
     if obstacles.bounds is None or not radius > 0.0:
         return False
     x0, y0, x1, y1 = obstacles.bounds
@@ -51,13 +50,12 @@ def provably_disconnected(obstacles: ObstacleSet, start: np.ndarray | tuple[floa
     ys = y0 + (np.arange(ny) + 0.5) * h
     gx, gy = np.meshgrid(xs, ys)
     open_ = obstacles.points_clear(np.column_stack([gx.ravel(), gy.ravel()]), limit)
-    open_ = open_.reshape(ny, nx)
-    labels, _ = ndimage.label(open_, structure=np.ones((3, 3), dtype=int))
+    open_ = np.ascontiguousarray(open_.reshape(ny, nx), dtype=np.bool_)
 
     def cell_of(p: np.ndarray | tuple[float, float]) -> tuple[int, int]:
         return (min(max(int((p[1] - y0) // h), 0), ny - 1), min(max(int((p[0] - x0) // h), 0), nx - 1))
 
-    a, b = labels[cell_of(start)], labels[cell_of(goal)]
+    (a0, a1), (b0, b1) = cell_of(start), cell_of(goal)
     # a point on a cell border also belongs to the neighbour: only conclude when the
-    # endpoints' own cells are open and labelled differently
-    return bool(a != 0 and b != 0 and a != b)
+    # endpoints' own cells are open and not joined
+    return bool(open_[a0, a1] and open_[b0, b1] and not connected8(open_, a0, a1, b0, b1))

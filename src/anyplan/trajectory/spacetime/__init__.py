@@ -9,7 +9,7 @@
 """
 
 from anyplan.trajectory.spacetime.lattice import VelocityPlan, edge_ok, lattice_dt, plan_velocity
-from anyplan.trajectory.spacetime.stmap import STMap, build_stmap, radii_at
+from anyplan.trajectory.spacetime.stmap import RowCache, STMap, build_stmap, radii_at
 from anyplan.trajectory.spacetime.timing import (
     RetimeResult,
     TimedCurveSegment,
@@ -18,5 +18,5 @@ from anyplan.trajectory.spacetime.timing import (
     verify,
 )
 
-__all__ = ["RetimeResult", "STMap", "TimedCurveSegment", "VelocityPlan", "build_stmap", "edge_ok",
+__all__ = ["RetimeResult", "RowCache", "STMap", "TimedCurveSegment", "VelocityPlan", "build_stmap", "edge_ok",
            "lattice_dt", "plan_velocity", "radii_at", "retime", "speed_caps", "verify"]

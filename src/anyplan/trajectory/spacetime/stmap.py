@@ -20,10 +20,11 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-__all__ = ["STMap", "build_stmap", "radii_at"]
+__all__ = ["STMap", "RowCache", "build_stmap", "radii_at"]
 
 _CHUNK = 16  # path cells per bounding circle of the coarse test
 _BLOCK = 16  # map rows per block of the coarse test
+_SPARE_ROWS = 200  # rows a RowCache computes beyond the first request
 
 
 def radii_at(obstacle: Any, t: np.ndarray) -> np.ndarray:
@@ -75,6 +76,45 @@ def _fill(out: np.ndarray, px: np.ndarray, py: np.ndarray, cx: np.ndarray, cy: n
     return hit
 
 
+class RowCache:
+    """The obstacles' centres and largest radii at the rows of one time grid, kept across maps.
+
+    Rows are [t_origin + j h, t_origin + (j+1) h] for integers j; a map built with a cache starts
+    on this grid (its first row at or before the requested start), so the maps of one
+    replanning (the same predictions, the same start) share the obstacles' rows instead of
+    sampling every obstacle again for every candidate path. Entries hold their obstacle, so an
+    ``id`` seen here is the same live object (predictions do not change once made).
+    """
+
+    def __init__(self, t_origin: float, h: float) -> None:
+        self.t_origin, self.h = float(t_origin), float(h)
+        self._rows: dict[int, tuple[Any, int, int, np.ndarray, np.ndarray]] = {}
+
+    def first_row(self, t: float) -> int:
+        """Index j of the row that contains time ``t`` [s]."""
+        return int(math.floor((float(t) - self.t_origin) / self.h + 1e-9))
+
+    def rows(self, o: Any, j0: int, j1: int) -> tuple[np.ndarray, np.ndarray]:
+        """Centres (j1 - j0, 2) [m] at the rows' middles and largest radii (j1 - j0,) [m] at
+        their ends and middles, rows j0 .. j1 - 1."""
+        e = self._rows.get(id(o))
+        if e is None or e[0] is not o or not (e[1] <= j0 and j1 <= e[2]):
+            # Rows to spare: the next map (a longer path, a longer wait) needs a few more.
+            if e is None or e[0] is not o:
+                a, b = j0, j1 + _SPARE_ROWS
+            else:
+                a, b = min(e[1], j0), max(e[2] + (e[2] - e[1]), j1)
+            j = np.arange(a, b)
+            t_mid = self.t_origin + self.h * (j + 0.5)
+            t_edges = self.t_origin + self.h * np.arange(a, b + 1)
+            q = np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2)
+            r_edge = radii_at(o, t_edges)
+            r_max = np.maximum(radii_at(o, t_mid), np.maximum(r_edge[:-1], r_edge[1:]))
+            e = (o, a, b, q, r_max)
+            self._rows[id(o)] = e
+        return e[3][j0 - e[1]:j1 - e[1]], e[4][j0 - e[1]:j1 - e[1]]
+
+
 class STMap:
     """A boolean s-t map (see the module docstring).
 
@@ -101,7 +141,7 @@ class STMap:
 
 def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_radius: float,
                 t_map: float, horizon_s: float, *, margin: float = 0.0, ds: float = 0.05,
-                h: float = 0.05, free_tail_m: float = 0.0) -> STMap:
+                h: float = 0.05, free_tail_m: float = 0.0, rows: RowCache | None = None) -> STMap:
     """The s-t map of a path for the predicted ``obstacles``.
 
     Args:
@@ -116,7 +156,17 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
         h: Row duration [s].
         free_tail_m: The last ``free_tail_m`` metres of the path are never marked (inside the
             goal tolerance the run is over).
+        rows: The obstacles' rows shared by the maps of one replanning (its ``h`` is used);
+            the map then starts at the row of ``rows`` that contains ``t_map`` and covers
+            ``t_map + horizon_s`` all the same.
     """
+    j_first = 0
+    if rows is not None:
+        h = rows.h
+        j_first = rows.first_row(t_map)
+        t_end = t_map + horizon_s
+        t_map = rows.t_origin + j_first * h
+        horizon_s = t_end - t_map
     ncell = max(1, int(math.ceil(length / ds)))
     nrow = max(1, int(math.ceil(horizon_s / h)))
     out = np.zeros((nrow, ncell), dtype=np.bool_)
@@ -133,16 +183,19 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     n_free = int(math.floor(max(length - free_tail_m, 0.0) / ds)) if free_tail_m > 0.0 else ncell
     gx, gy = float(px.mean()), float(py.mean())
     grad = float(np.max(np.hypot(px - gx, py - gy)))
-    t_edges = t_map + h * np.arange(nrow + 1)
-    t_mid = t_map + h * (np.arange(nrow) + 0.5)
+    if rows is None:
+        t_edges = t_map + h * np.arange(nrow + 1)
+        t_mid = t_map + h * (np.arange(nrow) + 0.5)
     near: list[Any] = []
     qs: list[np.ndarray] = []
     reaches: list[np.ndarray] = []
     for o in obstacles:
-        q = np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2)
-        r_mid = radii_at(o, t_mid)
-        r_edge = radii_at(o, t_edges)
-        r_max = np.maximum(r_mid, np.maximum(r_edge[:-1], r_edge[1:]))
+        if rows is not None:
+            q, r_max = rows.rows(o, j_first, j_first + nrow)
+        else:
+            q = np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2)
+            r_edge = radii_at(o, t_edges)
+            r_max = np.maximum(radii_at(o, t_mid), np.maximum(r_edge[:-1], r_edge[1:]))
         reach = robot_radius + r_max + margin + 0.5 * ds + 0.5 * float(o.max_speed) * h
         if float(np.min(np.hypot(q[:, 0] - gx, q[:, 1] - gy) - grad - reach)) > 0.0:
             continue  # never near the path

@@ -26,7 +26,7 @@ from anyplan.prediction.collision import PredictedCollision, first_collision
 from anyplan.trajectory.kinds import ST_PREFIX, SegmentKind
 from anyplan.trajectory.profile import SpeedProfile
 from anyplan.trajectory.spacetime.lattice import VelocityPlan, plan_velocity
-from anyplan.trajectory.spacetime.stmap import STMap, build_stmap, radii_at
+from anyplan.trajectory.spacetime.stmap import RowCache, STMap, build_stmap, radii_at
 from anyplan.trajectory.spline import SmoothCurve
 from anyplan.trajectory.trajectory import CurveSegment, Segment, Trajectory
 from anyplan.world.robot import RobotSpec
@@ -119,7 +119,7 @@ class RetimeResult:
 
 def retime(traj: Trajectory, obstacles: Sequence[Any], spec: RobotSpec, *, margin: float = 0.05,
            max_wait_s: float = 30.0, ds: float = 0.05, h: float = 0.05, target_dt: float = 0.25,
-           free_tail_m: float = 0.0) -> RetimeResult:
+           free_tail_m: float = 0.0, rows: RowCache | None = None) -> RetimeResult:
     """The earliest timing of ``traj``'s curve that avoids the predicted ``obstacles``.
 
     Args:
@@ -132,6 +132,8 @@ def retime(traj: Trajectory, obstacles: Sequence[Any], spec: RobotSpec, *, margi
         h: Row duration [s] of the s-t map.
         target_dt: Approximate step [s] of the velocity lattice.
         free_tail_m: Path metres before the end never blocked (inside the goal tolerance).
+        rows: Obstacle rows shared by the re-timings of one replanning (a :class:`RowCache`,
+            whose ``h`` replaces ``h``): the map starts on its time grid.
 
     Returns:
         A :class:`RetimeResult`; its trajectory keeps the prefix segments unchanged.
@@ -150,10 +152,10 @@ def retime(traj: Trajectory, obstacles: Sequence[Any], spec: RobotSpec, *, margi
         return curve.position(curve.u_of_s(s))
 
     stmap = build_stmap(points_at, length, obstacles, spec.radius, seg.t0, horizon, margin=margin,
-                        ds=ds, h=h, free_tail_m=free_tail_m)
+                        ds=ds, h=h, free_tail_m=free_tail_m, rows=rows)
     x0, x1 = speed_caps(seg.profile, spec, ds, stmap.forbidden.shape[1])
     v0 = float(seg.profile.v[0])
-    plan = plan_velocity(stmap.forbidden, stmap.t_map, h, ds, x0, x1, length, seg.t0, v0,
+    plan = plan_velocity(stmap.forbidden, stmap.t_map, stmap.h, ds, x0, x1, length, seg.t0, v0,
                          spec.a_max, spec.v_max, target_dt=target_dt, horizon_s=horizon)
     if plan is None:
         return RetimeResult(None, None, stmap, nominal)
