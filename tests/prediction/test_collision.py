@@ -158,3 +158,28 @@ def test_horizon_only_for_extrapolated_predictions():
     assert ConstantTwistPredictor().predict([seen])[0].until == np.inf
     with pytest.raises(ValueError, match="horizon_s"):
         ConstantTwistPredictor(horizon_s=0.0)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_coarse_certificate_changes_no_answer(seed, monkeypatch):
+    # The coarse pass (every 16th grid point) only skips obstacles it certifies clear: every
+    # contact, time and position is that of the fine grid alone, growing discs included.
+    from anyplan.prediction import collision
+    from anyplan.prediction.base import RadiusGrowth
+
+    rng = np.random.default_rng(seed)
+    lo, hi = (0, 0, -np.pi, 0.0, -0.2), (15, 11, np.pi, 0.8, 0.2)
+    obs = [PredictedObstacle(f"o{i}", float(rng.uniform(0.2, 0.5)),
+                             UnicycleMotion(*rng.uniform(lo, hi)),
+                             RadiusGrowth(0.0, np.array([0.0, 5.0]), np.array([0.0, 0.5])) if i % 3 == 0
+                             else None)
+           for i in range(20)]
+    for mid in MOTIONS:
+        answers = []
+        for coarse in (16, 10**9):  # 10**9: the coarse pass is skipped
+            monkeypatch.setattr(collision, "_COARSE", coarse)
+            collision._MEMO.clear()
+            answers.append([predict_collisions(MOTIONS[mid], obs, 0.3, margin=0.05, sample_dt=sd)
+                            for sd in (None, 0.02)])
+        assert _same(answers[0], answers[1])
+    assert any(answers[0])
