@@ -28,33 +28,46 @@ _DONE: set[str] = set()
 
 
 class compiling_notifier:  # noqa: N801 - a context manager used like a function
-    """Within the ``with`` block, call ``callback()`` once at numba's first real compilation.
+    """Within the ``with`` block, call ``callback()`` once at numba's first real compilation
+    (a cache miss; loading cached machine code is not one).
 
     Attributes:
         compiled: True once something was compiled inside the block.
+        seconds: Wall time [s] spent compiling inside the block (nested compilations, of the
+            functions a kernel calls, counted once).
+        count: Number of functions compiled (each specialisation, nested ones included).
     """
 
     def __init__(self, callback: Callable[[], None] | None) -> None:
         self.callback = callback
         self.compiled = False
+        self.seconds = 0.0
+        self.count = 0
         self._listener: Any = None
 
     def __enter__(self) -> compiling_notifier:
         from numba.core import event
 
         notifier = self
+        depth = [0, 0.0]
 
-        class _First(event.Listener):
+        class _Listener(event.Listener):
             def on_start(self, ev: event.Event) -> None:
+                notifier.count += 1
+                if depth[0] == 0:
+                    depth[1] = time.perf_counter()
+                depth[0] += 1
                 if not notifier.compiled:
                     notifier.compiled = True
                     if notifier.callback is not None:
                         notifier.callback()
 
             def on_end(self, ev: event.Event) -> None:
-                pass
+                depth[0] -= 1
+                if depth[0] == 0:
+                    notifier.seconds += time.perf_counter() - depth[1]
 
-        self._listener = _First()
+        self._listener = _Listener()
         event.register("numba:compile", self._listener)
         return self
 
@@ -88,7 +101,7 @@ def _motion() -> None:
     obs, spec = _scene()
     path = np.array([[0.5, 0.5], [3.0, 1.2], [3.5, 3.5]])
     for state in (RobotState(0.5, 0.5, 0.0), RobotState(0.5, 0.5, 0.3, 0.2, 0.1)):
-        traj = plan_motion(path, spec, state, obs, 0.0)
+        traj = plan_motion(path, spec, state, obs, 0.0, margin=0.015, grid_step=0.05)
         traj.sample(np.array([0.5]))
         traj.sample(np.linspace(0.0, traj.t_end, 7))
 

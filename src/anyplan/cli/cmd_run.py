@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 from anyplan.agents.base import AGENTS, make_agent
@@ -64,7 +65,25 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """Simulate one run and write its result and picture."""
+    """Simulate one run and write its result and picture; say so on stderr if numba compiles
+    kernels (the first run on a machine), and for how long."""
+    from anyplan.agents.warmup import compiling_notifier
+
+    with compiling_notifier(_compiling_notice) as note:
+        code = _run(args)
+    if note.compiled:
+        sys.stderr.write(f"anyplan: compiled {note.count} kernel functions in {note.seconds:.1f} s "
+                         "(once: later runs load them from the cache)\n")
+    return code
+
+
+def _compiling_notice() -> None:
+    sys.stderr.write("anyplan: compiling kernels for this machine (once; later runs load them "
+                     "from the cache)\n")
+    sys.stderr.flush()
+
+
+def _run(args: argparse.Namespace) -> int:
     scenario = apply_perception("run", [load_scenario(args.scenario)], args)[0]
     config = run_config(args, args.planner)  # unknown names and bad settings fail before any work
     try:
@@ -93,7 +112,6 @@ def cmd_run(args: argparse.Namespace) -> int:
         check_mcap(args.mcap)
         checks.writable_file(args.mcap, "run: --mcap", (".mcap",), make_parent=False)
     agent = make_agent(args.planner, **config)
-    _prepare_kernels(getattr(agent, "kernel_parts", ()))
     result = simulate(scenario, agent, seed=args.seed, config=cfg)
     (out / "result.json").write_text(json.dumps(result.to_dict(), indent=1))
     if not args.no_plot:
@@ -110,29 +128,6 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         print(f"  animation      {animate_run(scenario, result, args.animate, speed=args.speed)}")
     return 0 if result.reached_goal else 1
-
-
-def _prepare_kernels(parts: tuple[str, ...]) -> None:
-    """Load the machine code of the agent's kernel ``parts`` up front; only when numba really
-    compiles (the first run on a machine), say so on stderr."""
-    if not parts:
-        return
-    import sys
-    import time
-
-    from anyplan.agents.warmup import warm_up_kernels
-
-    compiled: list[bool] = []
-
-    def notice() -> None:
-        compiled.append(True)
-        sys.stderr.write("anyplan: compiling kernels for this machine (once; later runs load "
-                         "them from the cache)\n")
-
-    t0 = time.perf_counter()
-    warm_up_kernels(parts, on_compile=notice)
-    if compiled:
-        sys.stderr.write(f"anyplan: kernels compiled in {time.perf_counter() - t0:.1f} s\n")
 
 
 def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
