@@ -121,3 +121,25 @@ def test_ct_jacobian_matches_finite_differences(w):
     else:
         exp = [1.0 + 0.7 * 0.4, 2.0 - 0.3 * 0.4]
     np.testing.assert_allclose(f[0, :2], exp, atol=1e-6)
+
+
+def test_a_jump_restarts_the_track_instead_of_a_fast_motion():
+    # An obstacle walking at 1 m/s along x teleports 6 m back (a looping track's jump): the
+    # track restarts at the new place (at rest, counted) instead of estimating a dash of
+    # -60 m/s; an ordinary walk never triggers it.
+    from anyplan.prediction.detection import Detection
+    from anyplan.prediction.tracking import Tracker
+
+    tr = Tracker()
+    rng = np.random.default_rng(0)
+    for k in range(30):
+        t = 0.1 * k
+        x = 0.1 * k if k < 20 else 0.1 * k - 6.0
+        tr.update(t, [Detection("a", t, x + 0.05 * rng.standard_normal(),
+                                0.05 * rng.standard_normal(), 0.3)])
+        if k == 19:
+            assert tr.restarted == 0
+            assert tr.estimates(t)[0].speed == pytest.approx(1.0, abs=0.2)
+    assert tr.restarted == 1
+    est = tr.estimates(2.9)[0]
+    assert abs(est.state[0] - (2.9 - 6.0)) < 0.2 and est.speed < 2.0

@@ -29,7 +29,9 @@ from anyplan.agents.stats import SpaceTimeStats
 from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import MotionModel, SequentialConfig, SequentialResult
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle, RadiusGrowth
+from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.kinds import ST_PREFIX, MotionKind
+from anyplan.trajectory.motion import polyline_trajectory
 from anyplan.trajectory.spacetime import RowCache, retime, verify
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import RobotState
@@ -119,7 +121,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     def __init__(self, config: SequentialConfig | None = None, *, patience_s: float = 3.0,
                  max_wait_s: float = 30.0, lattice_dt_s: float = 0.25, accept_s: float = 0.5,
                  horizon_s: float | None = 3.0, plan_extra_m: float | None = 0.3,
-                 **kwargs: Any) -> None:
+                 guard: str = "growth", **kwargs: Any) -> None:
         loop = {k: kwargs.pop(k) for k in list(kwargs) if k in _LOOP_FIELDS}  # e.g. from --set
         if config is None:
             config = dataclasses.replace(_DEFAULT_LOOP, **loop)
@@ -133,6 +135,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         if horizon_s is not None and not (isinstance(horizon_s, int | float) and horizon_s > 0.0):
             raise ValueError(f"horizon_s: must be > 0 or null, got {horizon_s!r}")
         self.horizon_s = None if horizon_s is None else float(horizon_s)
+        if guard not in ("growth", "horizon", "never"):
+            raise ValueError(f"guard: 'growth', 'horizon' or 'never', got {guard!r}")
+        self.guard_mode = guard
         if plan_extra_m is not None and not (isinstance(plan_extra_m, int | float)
                                              and plan_extra_m >= 0.0):
             raise ValueError(f"plan_extra_m: must be >= 0 or null, got {plan_extra_m!r}")
@@ -242,6 +247,13 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             out.append(o)
         return out
 
+    def _guarded_by(self, safe: list[PredictedObstacle]) -> bool:
+        """Whether the safety guard decides what starts: predictions with uncertain discs
+        (``guard="growth"``, tracked perception), any with a horizon (``"horizon"``), or never."""
+        if self.guard_mode == "horizon":
+            return True
+        return self.guard_mode == "growth" and any(o.growth is not None for o in safe)
+
     def _capped(self, preds: list[PredictedObstacle]) -> list[PredictedObstacle]:
         """``preds`` with their extra radius capped at ``plan_extra_m`` (what paths are planned
         and timed against; the safety guard keeps the full growth)."""
@@ -265,10 +277,44 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit)
         if dec.kind in ("motion", "keep"):
             return dec.kind, dec.trajectory
+        kind, tr, clear = self._evasions(t_switch, state, safe, motion, dec)
         self.record.fallbacks.append(
-            {"t": float(obs.t), "kind": dec.kind, "reason": dec.reason or reason,
-             "predicted_clearance_m": _finite(dec.predicted_clearance_m)})
-        return dec.kind, dec.trajectory
+            {"t": float(obs.t), "kind": kind, "reason": dec.reason or reason,
+             "predicted_clearance_m": _finite(clear)})
+        return kind, tr
+
+    def _evasions(self, t: float, state: RobotState, safe: list[PredictedObstacle],
+                  motion: Trajectory | None, dec: Any) -> tuple[str, Any, float | None]:
+        """The guard's fallback ``dec``, or a better one by the guard's own ranking (moving part
+        predicted free first, then the largest predicted clearance over its horizon): the
+        proposed ``motion``, or driving ``v_max x 1.5 s`` in one of 8 directions (obstacles that
+        ignore the robot are escaped by moving, not only by stopping)."""
+        guard, spec = self.guard, self.spec
+        cfg = guard.config
+        h = t + cfg.horizon_s
+        best = (bool(dec.safe), -math.inf if dec.predicted_clearance_m is None
+                else float(dec.predicted_clearance_m))
+        out: tuple[str, Any, float | None] = (dec.kind, dec.trajectory, dec.predicted_clearance_m)
+        cands: list[tuple[str, Any]] = [] if motion is None else [("motion", motion)]
+        p0 = np.array([state.x, state.y])
+        radius = spec.radius + cfg.margin
+        dist = 1.5 * spec.v_max
+        for k in range(8):
+            a = state.theta + k * math.pi / 4.0
+            target = p0 + dist * np.array([math.cos(a), math.sin(a)])
+            if not self.obstacles.segment_free(p0, target, radius):
+                continue
+            tr = polyline_trajectory(np.array([p0, target]), spec, state, t, self.obstacles, radius)
+            if tr.certified_free:
+                cands.append(("evade", tr))
+        for kind, tr in cands:
+            t_end = max(float(tr.t_end), t)
+            free = first_collision(tr, safe, spec.radius, t_from=t, t_until=t_end,
+                                   margin=cfg.margin, sample_dt=cfg.sample_dt) is None
+            clear = guard.clearance(tr, safe, t, max(h, t_end))
+            if (free, clear) > best:
+                best, out = (free, clear), (kind, tr, clear)
+        return out
 
     def _fallback(self, obs: Observation, t_switch: float, preds: list[PredictedObstacle],
                   reason: str) -> Trajectory:
@@ -309,8 +355,10 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             res = self.loop.replan(np.array([state.x, state.y]),
                                    np.asarray(self.spec.goal, dtype=float), preds, t,
                                    self._timed_fn(state, t_ready, self.patience_s))
-        if not self._cands and self._tried:
-            # No short timing: allow long waits on the shortest path and on the last detour.
+        if not self._cands and self._tried and not (
+                uncertain and self.horizon_s is not None and self.patience_s >= self.horizon_s):
+            # No short timing: allow long waits on the shortest path and on the last detour
+            # (useless with predictions that end before patience_s: nothing is left to wait for).
             build = self._timed_fn(state, t_ready, self.max_wait_s)
             tried = self._tried
             for i in sorted({0, len(tried) - 1}):
@@ -328,7 +376,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         # really have, on the same path (no new search).
         t_switch, motion = self._take_up(obs, t_ready, wall, d, dt, motion,
                                          lambda state, t_s: self._retime_path(state, t_s, path, shapes))
-        if uncertain:
+        if uncertain and self._guarded_by(safe):
             kind, motion = self._guard(obs, t_switch, motion, safe, res.status)
             if kind == "keep":
                 return
@@ -359,7 +407,10 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         if not len(path):
             return None
         self._cands = []
-        self._timed_fn(state, t_switch, self.max_wait_s)(np.asarray(path), shapes, 0.0)
+        wait = self.max_wait_s
+        if self.horizon_s is not None and any(o.until < math.inf for o in self._preds):
+            wait = min(wait, self.horizon_s + self.patience_s)
+        self._timed_fn(state, t_switch, wait)(np.asarray(path), shapes, 0.0)
         return self._cands[0][1] if self._cands else None
 
     def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
@@ -384,7 +435,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         safe = self._planning_preds(preds, np.array([obs.robot.x, obs.robot.y]), t)
         if safe is not preds:
             preds = self._capped(safe)
-            if not self.guard.still_safe(traj, safe, t, self.check_period_s + 0.1):
+            if self._guarded_by(safe) and not self.guard.still_safe(traj, safe, t,
+                                                                   self.check_period_s + 0.1):
                 self._replan(obs, preds, "safety: the motion in use can no longer stop in time")
                 return
         hit = verify(traj, preds, spec.radius, t_from=t,

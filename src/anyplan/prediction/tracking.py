@@ -39,6 +39,10 @@ class TrackerConfig:
         switch_rate: Model switching rate [1/s].
         init_speed_sigma: Velocity standard deviation [m/s] of a new track.
         drop_after_s: A track not detected for this long [s] is dropped.
+        gate_m: A detection farther than this [m] from its track's predicted position, and
+            outside its ``gate_chi2`` gate under every model, restarts the track there (the
+            obstacle jumped: a teleport is a leave and a new appearance, not a fast motion).
+        gate_chi2: Squared Mahalanobis distance of that gate (2 degrees of freedom).
     """
 
     sigma_m: float = setting(0.05, lo=0.0, unit="m", doc="measurement noise per axis")
@@ -51,6 +55,10 @@ class TrackerConfig:
                                       doc="velocity sigma of a new track")
     drop_after_s: float = setting(2.0, lo=0.0, lo_open=True, unit="s",
                                   doc="a track unseen this long is dropped")
+    gate_m: float = setting(1.0, lo=0.0, lo_open=True, unit="m",
+                            doc="a detection this far outside the gate restarts its track")
+    gate_chi2: float = setting(25.0, lo=0.0, lo_open=True, unit="",
+                               doc="squared Mahalanobis gate of the restart")
 
     def __post_init__(self) -> None:
         validate(self)
@@ -153,6 +161,7 @@ class Tracker:
         self.radius = np.zeros(0)
         self.n = np.zeros(0, dtype=int)
         self.dropped = 0
+        self.restarted = 0  # tracks restarted at a detection outside their gate (jumps)
 
     def __len__(self) -> int:
         return len(self.names)
@@ -208,11 +217,27 @@ class Tracker:
         self.mu[idx] = mu / mu.sum(axis=1, keepdims=True)
         self.x[idx], self.P[idx] = x, P
 
-    def _add(self, d: Detection) -> None:
+    def _initial(self, d: Detection) -> tuple[np.ndarray, np.ndarray]:
+        """State and covariance of a track starting at detection ``d`` (at rest, uncertain)."""
         cfg = self.config
         r2 = max(cfg.sigma_m, 1e-3) ** 2
         x = np.array([d.x, d.y, 0.0, 0.0, 0.0])
         P = np.diag([r2, r2, cfg.init_speed_sigma ** 2, cfg.init_speed_sigma ** 2, 0.3 ** 2])
+        return x, P
+
+    def _outside_gate(self, idx: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """Tracks ``idx`` (predicted to the detection time) whose detection z (N, 2) is farther
+        than ``gate_m`` from the predicted position and outside the gate of every model."""
+        cfg = self.config
+        r2 = max(cfg.sigma_m, 1e-3) ** 2
+        y = z[:, None, :] - self.x[idx][:, :, :2]
+        S = self.P[idx][:, :, :2, :2] + r2 * np.eye(2)
+        md = np.einsum("nma,nmab,nmb->nm", y, np.linalg.inv(S), y)
+        far = np.hypot(y[..., 0], y[..., 1]).min(axis=1) > cfg.gate_m
+        return far & (md.min(axis=1) > cfg.gate_chi2)
+
+    def _add(self, d: Detection) -> None:
+        x, P = self._initial(d)
         self.names.append(d.name)
         self.x = np.concatenate([self.x, np.broadcast_to(x, (1, 2, 5))])
         self.P = np.concatenate([self.P, np.broadcast_to(P, (1, 2, 5, 5))])
@@ -240,7 +265,15 @@ class Tracker:
         if upd:
             idx = np.array([i for i, _ in upd])
             self._predict(idx, t)
-            self._update(idx, np.array([[d.x, d.y] for _, d in upd]))
+            z = np.array([[d.x, d.y] for _, d in upd])
+            jumped = self._outside_gate(idx, z)
+            for k in np.flatnonzero(jumped):  # restarted where it is now
+                x0, P0 = self._initial(upd[k][1])
+                self.x[idx[k]], self.P[idx[k]], self.mu[idx[k]] = x0, P0, (0.8, 0.2)
+                self.n[idx[k]] = 0
+                self.restarted += 1
+            if (~jumped).any():
+                self._update(idx[~jumped], z[~jumped])
             self.last_seen[idx] = t
             self.n[idx] += 1
             self.radius[idx] = [d.radius for _, d in upd]
