@@ -183,3 +183,81 @@ def test_few_obstacles_build_no_index():
 def test_bad_boxes_are_refused():
     with pytest.raises(ValueError, match="xmax > xmin"):
         ObstacleSet([], boxes=np.array([[0.0, 0.0, 0.0, 1.0]]))
+
+
+@given(st.integers(0, 2**31 - 1), st.floats(0.02, 0.5), st.booleans())
+@settings(max_examples=30, deadline=None)
+def test_capped_clearance_is_the_exact_one_below_the_cap(seed, p, walls):
+    """segment_clearance_below(cap) == min(exact clearance, cap), bit for bit below the cap
+    (it scans only the cells within cap: the filter never skips a box nearer than the cap)."""
+    rng = np.random.default_rng(seed)
+    occ, cells = _random_map(rng, 30, 40, p)
+    if len(cells) == 0:
+        return
+    merged = cell_boxes(merge_cells(occ), (-1.3, 0.7), 0.25)
+    obs = ObstacleSet([Circle((4.0, 4.0), 0.4)], bounds=(-2.0, 0.0, 10.0, 9.0) if walls else None,
+                      boxes=merged, index=True)
+    a = rng.uniform([-2.5, -0.5], [10.5, 9.5], size=(40, 2))
+    b = a + rng.normal(0.0, 0.3, size=a.shape)
+    for q, r in zip(a, b, strict=True):
+        exact = coll.segment_clearance_kernel(q[0], q[1], r[0], r[1], obs.arrays, -1.0)
+        dq = _pt_boxes(q, cells)  # a box nearest to the segment is this near to q
+        near = cells[dq <= dq.min() + float(np.hypot(*(r - q))) + 1e-9]
+        brute = min(min(_seg_box(q, r, bx) for bx in near),
+                    max(_pt_seg(np.array([4.0, 4.0]), q, r) - 0.4, 0.0))
+        if walls:
+            brute = min(brute, *(max(0.0, min(x[0] + 2.0, 10.0 - x[0], x[1], 9.0 - x[1]))
+                                 for x in (q, r)))
+        assert exact == pytest.approx(brute, abs=1e-9)
+        # caps of a length scale (a cap below ~1e-150 m squares to 0: meaningless)
+        for cap in {0.01, 0.1, 0.35, exact, np.nextafter(exact, np.inf), 2.0} - {0.0, 5e-324}:
+            got = coll.segment_clearance_below_kernel(q[0], q[1], r[0], r[1], obs.arrays, cap)
+            assert got == (exact if exact < cap else cap)
+
+
+@given(st.integers(0, 2**31 - 1), st.floats(0.2, 0.7))
+@settings(max_examples=30, deadline=None)
+def test_buried_capsules_have_zero_clearance(seed, p):
+    """capsule_buried is conservative: when it says True, every segment within the pad of the
+    segment (sampled, to the capsule's edge) has clearance exactly 0 (brute force and kernel)."""
+    rng = np.random.default_rng(seed)
+    occ, cells = _random_map(rng, 30, 40, p)
+    if len(cells) == 0:
+        return
+    merged = cell_boxes(merge_cells(occ), (-1.3, 0.7), 0.25)
+    obs = ObstacleSet([Circle((4.0, 4.0), 0.6)], bounds=(-2.0, 0.0, 10.0, 9.0), boxes=merged,
+                      index=True)
+    n_buried = 0
+    for _ in range(200):
+        q = rng.uniform([-2.5, -0.5], [10.5, 9.5])
+        r = q + rng.normal(0.0, 0.1, size=2)
+        pad = float(rng.uniform(0.0, 0.05))
+        if not coll.capsule_buried_kernel(q[0], q[1], r[0], r[1], pad, obs.arrays):
+            continue
+        n_buried += 1
+        for _ in range(10):
+            u = q + rng.uniform(0, 1) * (r - q) + pad * rng.uniform(-1, 1, 2) / np.sqrt(2)
+            v = q + rng.uniform(0, 1) * (r - q) + pad * rng.uniform(-1, 1, 2) / np.sqrt(2)
+            assert coll.segment_clearance_kernel(u[0], u[1], v[0], v[1], obs.arrays, -1.0) == 0.0
+            near = cells[(cells[:, 0] <= max(u[0], v[0]) + 0.1) & (cells[:, 2] >= min(u[0], v[0]) - 0.1)
+                         & (cells[:, 1] <= max(u[1], v[1]) + 0.1) & (cells[:, 3] >= min(u[1], v[1]) - 0.1)]
+            brute = min(min((_seg_box(u, v, bx) for bx in near), default=np.inf),
+                        max(_pt_seg(np.array([4.0, 4.0]), u, v) - 0.6, 0.0),
+                        *(max(0.0, min(x[0] + 2.0, 10.0 - x[0], x[1], 9.0 - x[1])) for x in (u, v)))
+            assert brute == 0.0
+    assert n_buried > 0 or p < 0.3
+
+
+def test_fingerprint_tells_sets_apart():
+    boxes = np.array([[0.0, 0.0, 1.0, 1.0]] * 1 + [[2.0 + i, 0.0, 2.5 + i, 0.5] for i in range(60)])
+    a = ObstacleSet([], bounds=(-1, -1, 70, 5), boxes=boxes)
+    assert a.indexed
+    same = ObstacleSet([], bounds=(-1, -1, 70, 5), boxes=boxes.copy())
+    assert a.fingerprint == same.fingerprint
+    sq = square((0.5, 3.0), 0.4)
+    assert a.with_shapes([sq]).fingerprint == a.with_shapes([sq]).fingerprint
+    others = [ObstacleSet([], bounds=(-1, -1, 70, 6), boxes=boxes), a.with_shapes([sq]),
+              a.with_shapes([square((0.5, 3.0), 0.41)]), a.with_shapes([Circle((1.0, 3.0), 0.2)]),
+              ObstacleSet([], bounds=(-1, -1, 70, 5), boxes=boxes[1:])]
+    prints = [o.fingerprint for o in [a, *others]]
+    assert len(set(prints)) == len(prints)

@@ -116,3 +116,33 @@ def test_branch_and_bound_finds_the_same_worst_pieces(seed):
         assert _reduce(kk, fu, fc) == (ks.tolist(), bu.tolist(), bc.tolist())
         if len(kk) == 0:
             assert bmargin == margin
+
+
+@pytest.mark.parametrize("seed", range(16))
+def test_branch_and_bound_on_maps_finds_the_same_worst_pieces(seed):
+    # The same on a map: curves through walls (buried pieces: no clearance queries below them),
+    # past them (capped queries, deferred pieces) and out of the arena; and the memo answers a
+    # repeated question with the same answer.
+    from anyplan.geometry.cells import cell_boxes, merge_cells
+
+    rng = np.random.default_rng(seed)
+    occ = np.zeros((60, 80), dtype=bool)
+    for _ in range(6):  # walls and blocks of cells
+        j, i = int(rng.integers(0, 55)), int(rng.integers(0, 75))
+        occ[j:j + int(rng.integers(1, 5)), i:i + int(rng.integers(1, 25))] = True
+    occ |= rng.random(occ.shape) < 0.01
+    boxes = cell_boxes(merge_cells(occ), (0.0, 0.0), 0.05)
+    obs = ObstacleSet([Circle((2.0, 1.5), 0.2)], bounds=(0.1, 0.1, 3.9, 2.9) if seed % 2 else None,
+                      boxes=boxes, index=True)
+    assert obs.indexed
+    pts = rng.uniform([0.0, 0.0], [4.0, 3.0], (5, 2))
+    c = SmoothCurve(pts, start_heading=float(rng.uniform(-np.pi, np.pi)), grid_step=0.02)
+    for radius in (0.02, 0.1, 0.3):
+        kk, fu, fc, margin = failing_pieces(c, obs, radius, 4)
+        ks, bu, bc, bmargin = worst_failures(c, obs, radius, 4)
+        assert _reduce(kk, fu, fc) == (ks.tolist(), bu.tolist(), bc.tolist())
+        if len(kk) == 0:
+            assert bmargin == margin
+        again = worst_failures(c, obs, radius, 4)
+        assert [a.tolist() for a in again[:3]] == [ks.tolist(), bu.tolist(), bc.tolist()]
+        assert again[3] == bmargin or (math.isinf(bmargin) and math.isinf(again[3]))

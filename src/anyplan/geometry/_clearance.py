@@ -335,7 +335,7 @@ def point_clearance(px: float, py: float, obs: ObstacleArrays) -> float:
 
 @njit(cache=True)
 def _segment_clearance(ax: float, ay: float, bx: float, by: float, obs: ObstacleArrays,
-                       stop_below: float, exact: bool) -> float:
+                       stop_below: float, exact: bool, cap: float) -> float:
     vx = obs.vx
     vy = obs.vy
     starts = obs.starts
@@ -343,7 +343,7 @@ def _segment_clearance(ax: float, ay: float, bx: float, by: float, obs: Obstacle
     circles = obs.circles
     bounds = obs.bounds
     gmeta = obs.gmeta
-    best = INF
+    best = cap
     if bounds[0] <= bounds[2]:
         # The distance to the boundary of a convex region is concave along a segment inside
         # it, so its minimum is at an endpoint.
@@ -352,7 +352,7 @@ def _segment_clearance(ax: float, ay: float, bx: float, by: float, obs: Obstacle
         dw = min(dwa, dwb)
         if dw <= 0.0:
             return 0.0
-        best = dw
+        best = min(dw, cap)
         if best < stop_below:
             return best
     for k in range(circles.shape[0]):
@@ -399,7 +399,7 @@ def segment_clearance(ax: float, ay: float, bx: float, by: float, obs: ObstacleA
     Returns early, with some value below ``stop_below``, as soon as the clearance is known to
     be smaller than ``stop_below`` (pass ``-1`` for the exact minimum); otherwise exact.
     """
-    return _segment_clearance(ax, ay, bx, by, obs, stop_below, np.bool_(True))
+    return _segment_clearance(ax, ay, bx, by, obs, stop_below, np.bool_(True), INF)
 
 
 @njit(cache=True)
@@ -407,7 +407,60 @@ def segment_blocked(ax: float, ay: float, bx: float, by: float, obs: ObstacleArr
                     limit: float) -> bool:
     """True iff the exact clearance of segment ab is < ``limit`` [m] (pass/fail only: on a map
     it scans only the cells within ``limit`` of the segment)."""
-    return _segment_clearance(ax, ay, bx, by, obs, limit, np.bool_(False)) < limit
+    return _segment_clearance(ax, ay, bx, by, obs, limit, np.bool_(False), INF) < limit
+
+
+@njit(cache=True)
+def segment_clearance_below(ax: float, ay: float, bx: float, by: float, obs: ObstacleArrays,
+                            cap: float) -> float:
+    """The exact clearance [m] of segment ab when it is below ``cap``, otherwise ``cap``
+    (i.e. ``min(clearance, cap)``): on a map only the cells within ``cap`` of ab are scanned, so
+    a far-away answer costs what a pass/fail test at ``cap`` costs."""
+    return _segment_clearance(ax, ay, bx, by, obs, -1.0, np.bool_(True), cap)
+
+
+@njit(cache=True)
+def capsule_buried(ax: float, ay: float, bx: float, by: float, pad: float,
+                   obs: ObstacleArrays) -> bool:
+    """True if every point within ``pad`` [m] of segment ab (the capsule) is inside one circle,
+    one of the map's boxes (``n_boxes`` > 0, with the index) or beyond one of the arena's walls,
+    by more than 1e-9 m: then every segment in the capsule has clearance exactly 0 (a
+    conservative test: False says nothing)."""
+    pad = pad + 1e-9
+    sx0 = min(ax, bx) - pad
+    sx1 = max(ax, bx) + pad
+    sy0 = min(ay, by) - pad
+    sy1 = max(ay, by) + pad
+    bounds = obs.bounds
+    if bounds[0] <= bounds[2] and (sx1 < bounds[0] or sx0 > bounds[2] or sy1 < bounds[1]
+                                   or sy0 > bounds[3]):
+        return True
+    circles = obs.circles
+    for k in range(circles.shape[0]):
+        r = circles[k, 2] - pad
+        if r > 0.0 and (math.hypot(ax - circles[k, 0], ay - circles[k, 1]) < r
+                        and math.hypot(bx - circles[k, 0], by - circles[k, 1]) < r):
+            return True
+    gmeta = obs.gmeta
+    nbox = int(gmeta[6])
+    if gmeta[3] <= 0.0 or nbox == 0:
+        return False
+    h = gmeta[2]
+    nx = int(gmeta[3])
+    ny = int(gmeta[4])
+    i = int(math.floor((ax - gmeta[0]) / h))
+    j = int(math.floor((ay - gmeta[1]) / h))
+    if i < 0 or j < 0 or i >= nx or j >= ny:
+        return False
+    pbox = obs.pbox
+    gcsr = obs.gcsr
+    c = j * nx + i
+    for q in range(gcsr[c], gcsr[c + 1]):
+        k = gcsr[q]
+        if k < nbox and (pbox[k, 0] < sx0 and sx1 < pbox[k, 2] and pbox[k, 1] < sy0
+                         and sy1 < pbox[k, 3]):
+            return True
+    return False
 
 
 @njit(cache=True)
@@ -424,7 +477,8 @@ def points_clear(px: np.ndarray, py: np.ndarray, obs: ObstacleArrays, limit: flo
     """Mask (N,): the exact clearance of each point is >= ``limit`` [m] (pass/fail only)."""
     out = np.empty(px.shape[0], dtype=np.bool_)
     for n in range(px.shape[0]):
-        out[n] = _segment_clearance(px[n], py[n], px[n], py[n], obs, limit, np.bool_(False)) >= limit
+        out[n] = _segment_clearance(px[n], py[n], px[n], py[n], obs, limit, np.bool_(False),
+                                    INF) >= limit
     return out
 
 

@@ -20,6 +20,7 @@ Examples:
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Iterable, Sequence
 
 import numpy as np
@@ -30,7 +31,7 @@ from anyplan.geometry.index import MIN_INDEXED, NO_GRID, build_grid
 from anyplan.geometry.shapes import Circle, Polygon, Shape
 
 __all__ = ["ObstacleSet", "ObstacleArrays", "COLLISION_EPS", "segment_clearance_kernel",
-           "segment_blocked_kernel"]
+           "segment_clearance_below_kernel", "segment_blocked_kernel", "capsule_buried_kernel"]
 
 #: Tolerance [m] on contact: a clearance of ``r - COLLISION_EPS`` still counts as touching, not
 #: as penetrating, so that paths which graze an inflated boundary exactly are accepted.
@@ -41,10 +42,33 @@ COLLISION_EPS = 1e-9
 #: below ``stop_below``, once the clearance is known to be below it (``-1`` for the exact
 #: minimum). Callable from Python and from other ``@njit`` code.
 segment_clearance_kernel = k.segment_clearance
+#: Compiled ``(ax, ay, bx, by, obs: ObstacleArrays, cap) -> float``: ``min(clearance, cap)``,
+#: the exact clearance of segment ab when it is below ``cap`` [m], else ``cap``; on a map it
+#: scans only the cells within ``cap`` of the segment. Callable from ``@njit`` code.
+segment_clearance_below_kernel = k.segment_clearance_below
+#: Compiled ``(ax, ay, bx, by, pad, obs: ObstacleArrays) -> bool``: True if the ``pad``-
+#: neighbourhood of segment ab lies (by more than 1e-9 m) inside one circle, one map box or
+#: beyond an arena wall, so that every segment within it has clearance exactly 0; a
+#: conservative test (False says nothing). Callable from ``@njit`` code.
+capsule_buried_kernel = k.capsule_buried
 #: Compiled ``(ax, ay, bx, by, obs: ObstacleArrays, limit) -> bool``: True iff the exact
 #: clearance of segment ab is < ``limit`` [m] (pass/fail only: on a map it scans only the cells
 #: within ``limit`` of the segment). Callable from Python and from other ``@njit`` code.
 segment_blocked_kernel = k.segment_blocked
+
+
+#: Digests of recent boxes arrays (kept alive here, so that an id seen is the same array).
+_BOX_DIGESTS: list[tuple[np.ndarray, bytes]] = []
+
+
+def _boxes_digest(boxes: np.ndarray) -> bytes:
+    for b, d in _BOX_DIGESTS:
+        if b is boxes:
+            return d
+    d = hashlib.blake2b(np.ascontiguousarray(boxes).tobytes(), digest_size=16).digest()
+    _BOX_DIGESTS.append((boxes, d))
+    del _BOX_DIGESTS[:-8]
+    return d
 
 
 class ObstacleSet:
@@ -113,6 +137,24 @@ class ObstacleSet:
 
     def __len__(self) -> int:
         return len(self.shapes) + len(self.boxes)
+
+    @property
+    def fingerprint(self) -> bytes:
+        """A digest of the obstacles (equal digests: the same record of arrays), for memos of
+        pure functions of the set. Computed once per set; the boxes' part once per boxes array
+        (a set made by :meth:`with_shapes` shares it), so it costs what the shapes cost."""
+        fp = self.__dict__.get("_fingerprint")
+        if fp is None:
+            # the record is a function of these: the boxes' vertices, the first starts and the
+            # grid's cells follow from the boxes, the polygons' boxes and gmeta (build_grid)
+            nb = len(self.boxes)
+            h = hashlib.blake2b(_boxes_digest(self.boxes), digest_size=16)
+            for a in (self.vx[4 * nb:], self.vy[4 * nb:], self.starts[nb:], self.pbox[nb:],
+                      self.circles, self._bounds_arr, self._gmeta):
+                h.update(np.ascontiguousarray(a).tobytes())
+                h.update(b"|")
+            fp = self.__dict__["_fingerprint"] = h.digest()
+        return fp
 
     @property
     def indexed(self) -> bool:
