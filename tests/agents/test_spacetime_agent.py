@@ -150,3 +150,27 @@ def test_planning_predictions_of_uncertain_obstacles():
     assert kept[0].radius_at(2.0) > kept[0].radius_at(t)  # still grows with the horizon
     announced = [PredictedObstacle("near", 0.25, near.motion)]
     assert agent._planning_preds(announced, p, t) is announced
+
+
+def test_evasion_beats_holding_before_a_fast_obstacle():
+    # A robot at rest, an obstacle at 1.5 m/s coming straight at it: holding, braking, turning
+    # away or backing off 0.6-1.2 m (the guard's fallbacks) are all struck within its horizon;
+    # st-bitstar also drives 1.5 s at v_max sideways and takes what the guard's ranking prefers.
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.world import RobotState, UnicycleMotion
+
+    agent = make_agent("st-bitstar")
+    agent.reset(_crossing_scenario(), np.random.default_rng(0))
+    state = RobotState(4.0, 3.0, math.pi / 2, 0.0, 0.0)
+    fast = [PredictedObstacle("F", 0.6, UnicycleMotion(10.0, 3.0, math.pi, 1.5), until=5.0)]
+    dec = agent.guard.fallback(0.0, state, fast, "test")
+    kind, tr, clear = agent._evasions(0.0, state, fast, None, dec)
+    assert dec.predicted_clearance_m < 0.0  # the guard alone: struck
+    assert kind == "evade" and clear > dec.predicted_clearance_m
+    assert agent.guard.clearance(tr, fast, 0.0, 5.0) == pytest.approx(clear)
+
+
+def test_guard_option():
+    assert make_agent("st-bitstar", guard="never").guard_mode == "never"
+    with pytest.raises(ValueError, match="guard"):
+        make_agent("st-bitstar", guard="sometimes")
