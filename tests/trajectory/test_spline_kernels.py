@@ -146,3 +146,24 @@ def test_branch_and_bound_on_maps_finds_the_same_worst_pieces(seed):
         again = worst_failures(c, obs, radius, 4)
         assert [a.tolist() for a in again[:3]] == [ks.tolist(), bu.tolist(), bc.tolist()]
         assert again[3] == bmargin or (math.isinf(bmargin) and math.isinf(again[3]))
+
+
+def test_smoothing_memo_answers_as_a_fresh_smoothing():
+    # A repeated smooth_path (same path, obstacles, settings) is answered from the memo: the same
+    # curve and counts as a fresh computation; other obstacles or settings are not mixed up.
+    from anyplan.geometry import square
+    from anyplan.trajectory.spline import smooth as sm
+
+    path = np.array([[0.5, 0.5], [2.0, 2.5], [4.0, 2.0], [5.5, 4.0]])
+    base = ObstacleSet([Circle((2.6, 1.6), 0.3)], bounds=(0.0, 0.0, 6.0, 5.0))
+    cases = [(base, 0.2, 0.3), (base.with_shapes([square((3.0, 3.2), 0.4)]), 0.2, 0.3),
+             (base, 0.25, 0.3), (base, 0.2, None)]
+    got = [sm.smooth_path(path, o, r, start_heading=h) for o, r, h in cases]
+    again = [sm.smooth_path(path, o, r, start_heading=h) for o, r, h in cases]
+    sm._MEMO.clear()
+    fresh = [sm.smooth_path(path, o, r, start_heading=h) for o, r, h in cases]
+    for a, b, c in zip(got, again, fresh, strict=True):
+        assert b.curve is a.curve  # from the memo
+        assert (a.rounds, a.points_added, a.margin) == (c.rounds, c.points_added, c.margin)
+        assert np.array_equal(a.curve.arrays.c, c.curve.arrays.c)
+    assert len({r.curve.arrays.c.tobytes() for r in got}) > 1  # the cases differ

@@ -13,6 +13,7 @@ Environment", §4. Measurements: ``docs/motion.md`` ("Smoothing and collision ce
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
 
@@ -44,6 +45,14 @@ class SmoothingResult:
     margin: float
 
 
+#: Recent answers of :func:`smooth_path`, newest last: (key, answer). A planner smooths the same
+#: path among the same obstacles several times (one path timed with several departure delays);
+#: the key is the content of every input, so a hit is the same computation. The answer's curve
+#: is shared (a :class:`SmoothCurve` is not changed once built).
+_MEMO: list[tuple[bytes, SmoothingResult]] = []
+_MEMO_SIZE = 16
+
+
 def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
                 start_heading: float | None = None, max_rounds: int = 10,
                 grid_step: float = 0.02, min_segment: float = 0.02,
@@ -67,6 +76,26 @@ def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
     Returns:
         A :class:`SmoothingResult`; ``curve`` is None when no certified curve was found.
     """
+    h = hashlib.blake2b(np.ascontiguousarray(path, dtype=float).tobytes(), digest_size=16)
+    h.update(obstacles.fingerprint)
+    h.update(repr((np.shape(path), float(radius), None if start_heading is None else float(start_heading),
+                   int(max_rounds), float(grid_step), float(min_segment), repair,
+                   None if start_curvature is None else float(start_curvature))).encode())
+    key = h.digest()
+    for k, ans in _MEMO:
+        if k == key:
+            return SmoothingResult(ans.curve, ans.rounds, ans.points_added, ans.margin)
+    out = _smooth_path(path, obstacles, radius, start_heading, max_rounds, grid_step, min_segment,
+                       repair, start_curvature)
+    _MEMO.append((key, out))
+    del _MEMO[:-_MEMO_SIZE]
+    return SmoothingResult(out.curve, out.rounds, out.points_added, out.margin)
+
+
+def _smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
+                 start_heading: float | None, max_rounds: int, grid_step: float,
+                 min_segment: float, repair: str, start_curvature: float | None
+                 ) -> SmoothingResult:
     pts = clean_path(path)
     if len(pts) < 2:
         raise ValueError("path must contain two distinct points")
