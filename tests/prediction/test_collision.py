@@ -183,3 +183,46 @@ def test_coarse_certificate_changes_no_answer(seed, monkeypatch):
                             for sd in (None, 0.02)])
         assert _same(answers[0], answers[1])
     assert any(answers[0])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_track_box_broad_phase_changes_no_answer(seed, monkeypatch):
+    # The broad phase over all obstacles at once (each obstacle's track box against the robot's
+    # coarse samples) only skips obstacles that the coarse certificate would skip: every
+    # contact, time and position is that of the loop alone; pacing (waypoints), circling,
+    # straight and growing discs, near the robot's route and far from it.
+    from anyplan.prediction import collision
+    from anyplan.prediction.base import RadiusGrowth
+    from anyplan.world.motion import WaypointMotion
+
+    rng = np.random.default_rng(seed)
+    obs = []
+    for i in range(40):
+        a, b = rng.uniform((0, 0), (15, 11)), rng.uniform((0, 0), (15, 11))
+        if i % 4 == 0:
+            m = UnicycleMotion(*rng.uniform((0, 0, -np.pi, 0.0, 0.1), (15, 11, np.pi, 0.8, 0.4)))
+        elif i % 4 == 1:
+            m = UnicycleMotion(*rng.uniform((0, 0, -np.pi, 0.0, 0.0), (15, 11, np.pi, 0.8, 0.0)))
+        else:
+            t1 = float(np.hypot(*(b - a))) / float(rng.uniform(0.3, 1.0)) + 0.1
+            m = WaypointMotion(np.array([[0.0, *a], [t1, *b], [2 * t1, *a]]))
+        g = RadiusGrowth(0.0, np.array([0.0, 5.0]), np.array([0.0, 0.5])) if i % 5 == 0 else None
+        obs.append(PredictedObstacle(f"o{i}", float(rng.uniform(0.2, 0.5)), m, g))
+    skipped = 0
+    for mid in MOTIONS:
+        answers = []
+        for broad in (True, False):
+            if not broad:
+                monkeypatch.setattr(collision, "_far_from_tracks",
+                                    lambda o, *a: np.zeros(len(o), dtype=bool))
+            collision._MEMO.clear()
+            answers.append([predict_collisions(MOTIONS[mid], obs, 0.3, margin=0.05, sample_dt=sd)
+                            for sd in (None, 0.02)])
+        monkeypatch.undo()
+        m = MOTIONS[mid]
+        grid = np.linspace(m.t_start, m.t_end, 200)
+        skipped += int(collision._far_from_tracks(obs, grid, m.positions(grid), m.max_speed,
+                                                  0.35).sum())
+        assert _same(answers[0], answers[1])
+        assert any(answers[0])
+    assert skipped > 0  # the broad phase did skip some

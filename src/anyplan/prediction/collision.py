@@ -24,6 +24,7 @@ import numpy as np
 
 from anyplan.geometry.moving import first_contact, first_contact_growing
 from anyplan.prediction.base import PredictedObstacle
+from anyplan.world.motion import TrackMotion, UnicycleMotion, WaypointMotion
 
 __all__ = ["TimedMotion", "SampledMotion", "PredictedCollision", "first_collision",
            "predict_collisions", "min_separation"]
@@ -138,6 +139,30 @@ _MEMO_SIZE = 8
 _COARSE = 16
 
 
+#: Per motion (by identity; the entry keeps it alive): a box (xmin, ymin, xmax, ymax) [m] that
+#: holds its position at every time (inf if none is known), and its max_speed.
+_TRACKS: dict[int, tuple[object, np.ndarray, float]] = {}
+
+
+def _track(o: PredictedObstacle) -> tuple[np.ndarray, float]:
+    m = o.motion
+    hit = _TRACKS.get(id(m))
+    if hit is not None and hit[0] is m:
+        return hit[1], hit[2]
+    box = np.array([-math.inf, -math.inf, math.inf, math.inf])
+    if isinstance(m, WaypointMotion | TrackMotion):  # interpolated (looping) keyframes
+        k = m.keyframes if isinstance(m, WaypointMotion) else m.samples
+        box = np.array([k[:, 1].min(), k[:, 2].min(), k[:, 1].max(), k[:, 2].max()])
+    elif isinstance(m, UnicycleMotion) and m.omega != 0.0:  # on its circle at all times
+        c, r = m.circle_center, abs(m.v / m.omega)
+        assert c is not None
+        box = np.array([c[0] - r, c[1] - r, c[0] + r, c[1] + r])
+    if len(_TRACKS) >= 4096:
+        _TRACKS.clear()
+    _TRACKS[id(m)] = (m, box, float(m.max_speed))
+    return box, float(m.max_speed)
+
+
 def _predict(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], robot_radius: float,
              t_from: float | None, t_until: float | None, margin: float, tol: float,
              sample_dt: float | None, first_only: bool) -> list[PredictedCollision]:
@@ -178,10 +203,11 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
     # there is clear (the bound holds on any interval), and is never sampled finely.
     ic = np.unique(np.r_[np.arange(0, len(grid), _COARSE), len(grid) - 1])
     gc, pc = grid[ic], p[ic]
+    far = _far_from_tracks(obstacles, gc, pc, vr, robot_radius + margin + extra)
     starts: list[tuple[float, int]] = []
     for k, o in enumerate(obstacles):
-        if o.until < t0:
-            continue  # predicted only before the interval
+        if o.until < t0 or far[k]:
+            continue  # predicted only before the interval, or never near the robot
         reach = robot_radius + o.radius + margin + extra
         if len(ic) < len(grid):
             d = np.hypot(*(pc - o.positions(gc)).T)
@@ -223,6 +249,34 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
         out.append(hit)
         out.sort(key=lambda c: c.t)
     return out
+
+
+def _far_from_tracks(obstacles: Sequence[PredictedObstacle], gc: np.ndarray, pc: np.ndarray,
+                     vr: float, reach0: float) -> np.ndarray:
+    """Broad phase, for all obstacles at once: True where an obstacle is certified clear by the
+    coarse certificate below without sampling it. An obstacle stays in its track's box B at
+    all times, so its gap to the robot is >= dist(robot, B) - max growth; that distance is
+    vr-Lipschitz in time, so >= (F_j + F_j+1 - vr dT_j) / 2 between coarse times. Where this
+    exceeds reach + L dT_max / 2 (L the gap's Lipschitz bound), every coarse (and fine)
+    interval's bound (>= min gap - L dT / 2) is above reach: the loop would skip it too."""
+    n = len(obstacles)
+    if n < 8 or len(gc) < 2:
+        return np.zeros(n, dtype=bool)
+    boxes = np.empty((n, 4))
+    lip = np.empty(n)
+    need = np.empty(n)
+    for k, o in enumerate(obstacles):
+        boxes[k], vo = _track(o)
+        rate = 0.0 if o.growth is None else o.growth.rate
+        lip[k] = vr + vo + rate
+        need[k] = reach0 + o.radius + (0.0 if o.growth is None else o.growth.max_extra)
+    dx = np.maximum(np.maximum(boxes[None, :, 0] - pc[:, 0, None], pc[:, 0, None] - boxes[None, :, 2]), 0.0)
+    dy = np.maximum(np.maximum(boxes[None, :, 1] - pc[:, 1, None], pc[:, 1, None] - boxes[None, :, 3]), 0.0)
+    f = np.hypot(dx, dy)  # (coarse times, obstacles); 0 for an unbounded track
+    dt = np.diff(gc)
+    lb = (0.5 * (f[:-1] + f[1:] - vr * dt[:, None])).min(axis=0)
+    with np.errstate(invalid="ignore"):
+        return lb > need + 0.5 * lip * float(dt.max()) + 1e-9 * (1.0 + need + lip)
 
 
 def first_collision(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], robot_radius: float,
