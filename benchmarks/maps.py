@@ -36,12 +36,14 @@ Usage::
     python benchmarks/maps.py --quick          # 30 x 20 office only, 5 seeds, 1 run per crowd
     python benchmarks/maps.py                  # all maps, 10 seeds, 3 runs per crowd
     python benchmarks/maps.py --json out.json --out maps/   # keep the results and the maps
+    python benchmarks/maps.py --quick --no-static --deterministic   # A/B two commits
 """
 
 from __future__ import annotations
 
 import argparse
 import gc
+import hashlib
 import json
 import math
 import resource
@@ -202,14 +204,18 @@ def _robot_caused(sc: Scenario, res: Any) -> bool | None:
     return bool(abs(row[4]) > 0.05)  # a map cell, a wall or a static shape
 
 
-def _drive(sc: Scenario, planners: list[str], runs: int, label: str) -> list[dict[str, Any]]:
+def _drive(sc: Scenario, planners: list[str], runs: int, label: str,
+           deterministic: bool = False) -> list[dict[str, Any]]:
     rows = []
     for planner in planners:
         times, reached, coll, caused, ttg, cpu, wall = [], 0, 0, 0, [], 0.0, 0.0
+        digest = hashlib.sha1()
+        kw = (AGENTS.get(planner).deterministic_settings or {}) if deterministic else {}
         for s in range(runs):
             gc.collect()
             c0, w0 = time.process_time(), time.perf_counter()
-            res = simulate(sc, make_agent(planner), seed=s)
+            res = simulate(sc, make_agent(planner, **kw), seed=s)
+            digest.update(np.round(res.trajectory_array[:, 1:3], 9).tobytes())
             cpu += time.process_time() - c0
             wall += time.perf_counter() - w0
             times += res.planning_times_s[1:] if len(res.planning_times_s) > 1 else res.planning_times_s
@@ -224,17 +230,18 @@ def _drive(sc: Scenario, planners: list[str], runs: int, label: str) -> list[dic
                "replan_ms_median": statistics.median(ms),
                "replan_ms_p90": ms[min(len(ms) - 1, int(0.9 * len(ms)))], "replans": len(times),
                "time_to_goal_s": statistics.median(ttg) if ttg else None, "rss_mb": _rss_mb(),
-               "run_cpu_s": cpu, "run_wall_s": wall}
+               "run_cpu_s": cpu, "run_wall_s": wall, "trajectory_digest": digest.hexdigest()[:10]}
         rows.append(row)
         print(f"  {label:26s} {planner:12s} reached {reached}/{runs}, collisions {coll} "
               f"(robot-caused {caused}), replanning median {row['replan_ms_median']:.1f} ms, "
               f"p90 {row['replan_ms_p90']:.1f} ms over {len(times)} calls, time to goal "
               f"{row['time_to_goal_s'] if ttg else float('nan'):.1f} s; whole runs: CPU {cpu:.1f} s "
-              f"in {wall:.1f} s wall")
+              f"in {wall:.1f} s wall; trajectories {row['trajectory_digest']}")
     return rows
 
 
-def dynamic_section(maps_dir: Path, quick: bool) -> list[dict[str, Any]]:
+def dynamic_section(maps_dir: Path, quick: bool, deterministic: bool = False
+                    ) -> list[dict[str, Any]]:
     from anyplan.experiments.floorplans import map_scenario, office, roughen
     from anyplan.experiments.many import many_obstacles
 
@@ -244,12 +251,13 @@ def dynamic_section(maps_dir: Path, quick: bool) -> list[dict[str, Any]]:
           "includes the initial plan, excluded)")
     plan = roughen(office(30, 20, rng=1), 0.3, 50, rng=1)
     # peer: the paper's scenario in the same run (README: 15.3 ms median on an unloaded machine)
-    rows = _drive(load_scenario("paper-3"), planners, 1, "peer: paper-3")
+    det = deterministic
+    rows = _drive(load_scenario("paper-3"), planners, 1, "peer: paper-3", det)
     for n in (2, 4):
         path = map_scenario(plan, maps_dir, f"office-walkers-{n}", n_walkers=n, rng=n)
-        rows += _drive(load_scenario(path), planners, runs, f"office-30x20 + {n} walkers")
+        rows += _drive(load_scenario(path), planners, runs, f"office-30x20 + {n} walkers", det)
     for n in (25, 50, 100):
-        rows += _drive(many_obstacles(n, rng=n), planners, runs, f"hall 40x30 + {n} movers")
+        rows += _drive(many_obstacles(n, rng=n), planners, runs, f"hall 40x30 + {n} movers", det)
     return rows
 
 
@@ -260,6 +268,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default=None, help="keep the generated maps in this directory")
     ap.add_argument("--json", default=None, help="write every figure to this file")
     ap.add_argument("--no-dynamic", action="store_true", help="skip sections 2 and 3")
+    ap.add_argument("--no-static", action="store_true", help="skip section 1")
+    ap.add_argument("--deterministic", action="store_true",
+                    help="sections 2-3 with the agents' --deterministic settings (runs depend only on "
+                         "the code: compare two commits by the printed trajectory digests)")
     args = ap.parse_args(argv)
     seeds = args.seeds or (5 if args.quick else 10)
     with tempfile.TemporaryDirectory() as tmp:
@@ -268,9 +280,11 @@ def main(argv: list[str] | None = None) -> int:
         from anyplan.agents.warmup import warm_up_kernels
 
         warm_up_kernels()
-        out: dict[str, Any] = {"static": static_section(maps_dir, args.quick, seeds)}
+        out: dict[str, Any] = {}
+        if not args.no_static:
+            out["static"] = static_section(maps_dir, args.quick, seeds)
         if not args.no_dynamic:
-            out["dynamic"] = dynamic_section(maps_dir, args.quick)
+            out["dynamic"] = dynamic_section(maps_dir, args.quick, args.deterministic)
     if args.json:
         Path(args.json).write_text(json.dumps(out, indent=1, default=float))
     return 0
