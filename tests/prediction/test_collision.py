@@ -225,4 +225,19 @@ def test_track_box_broad_phase_changes_no_answer(seed, monkeypatch):
                                                   0.35).sum())
         assert _same(answers[0], answers[1])
         assert any(answers[0])
+        # the first contact, with starts computed lazily from the interpolated lower bounds,
+        # is the earliest of all contacts, and what computing every start first gives
+        for sd in (None, 0.02):
+            collision._MEMO.clear()
+            lazy = first_collision(m, obs, 0.3, margin=0.05, sample_dt=sd)
+            assert _same(lazy, (predict_collisions(m, obs, 0.3, margin=0.05, sample_dt=sd)
+                                or [None])[0])
+            monkeypatch.setattr(collision, "_start_bounds",
+                                lambda o, far, *a: np.where(far, np.inf, -np.inf))
+            collision._MEMO.clear()
+            assert _same(lazy, first_collision(m, obs, 0.3, margin=0.05, sample_dt=sd))
+            monkeypatch.undo()
+            bounds = collision._start_bounds(obs, np.zeros(len(obs), dtype=bool), grid, grid,
+                                             m.positions(grid), m.max_speed, 0.35)
+            assert np.isfinite(bounds).any()
     assert skipped > 0  # the broad phase did skip some

@@ -15,6 +15,7 @@ prediction with a horizon (``PredictedObstacle.until``) is checked up to it only
 
 from __future__ import annotations
 
+import heapq
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -204,10 +205,11 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
     ic = np.unique(np.r_[np.arange(0, len(grid), _COARSE), len(grid) - 1])
     gc, pc = grid[ic], p[ic]
     far = _far_from_tracks(obstacles, gc, pc, vr, robot_radius + margin + extra)
-    starts: list[tuple[float, int]] = []
-    for k, o in enumerate(obstacles):
+    def start(k: int) -> float | None:
+        """The obstacle's first uncertified grid time, or None if it is certified clear."""
+        o = obstacles[k]
         if o.until < t0 or far[k]:
-            continue  # predicted only before the interval, or never near the robot
+            return None  # predicted only before the interval, or never near the robot
         reach = robot_radius + o.radius + margin + extra
         if len(ic) < len(grid):
             d = np.hypot(*(pc - o.positions(gc)).T)
@@ -216,7 +218,7 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
                 d = d - o.growth.at(gc)
                 rate = o.growth.rate
             if np.all(0.5 * (d[:-1] + d[1:] - (vr + o.max_speed + rate) * np.diff(gc)) > reach):
-                continue
+                return None
         d = np.hypot(*(p - o.positions(grid)).T)
         rate = 0.0
         if o.growth is not None:  # the gap to the grown disc; its slope adds the growth rate
@@ -226,12 +228,28 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
         bad = np.flatnonzero(lb <= reach)
         if o.until < t1:  # intervals that start after the prediction's horizon do not count
             bad = bad[grid[bad] <= o.until]
-        if len(bad):
-            starts.append((float(grid[bad[0]]), k))
-    starts.sort()
-    for ts, k in starts:
+        return float(grid[bad[0]]) if len(bad) else None
+
+    # Candidates in order of their start (ties by index). For the first contact only, an
+    # obstacle's start is computed when a lower bound of it comes up (_start_bounds): one that
+    # cannot start before the contact found is never sampled finely; the same candidates are
+    # searched in the same order as with every start computed first.
+    if first_only:
+        heap = [(b, 0, k) for k, b in enumerate(_start_bounds(obstacles, far, grid, gc, pc, vr,
+                                                              robot_radius + margin + extra))
+                if b < math.inf]
+    else:
+        heap = [(b, 1, k) for k in range(len(obstacles)) if (b := start(k)) is not None]
+    heapq.heapify(heap)
+    while heap:
+        ts, exact, k = heapq.heappop(heap)
         if first_only and out and out[0].t <= ts:
             break  # no later candidate can come before the contact already found
+        if not exact:
+            st = start(k)
+            if st is not None:
+                heapq.heappush(heap, (st, 1, k))
+            continue
         o = obstacles[k]
         reach = robot_radius + o.radius + margin + extra
         t1o = min(t1, o.until)
@@ -277,6 +295,43 @@ def _far_from_tracks(obstacles: Sequence[PredictedObstacle], gc: np.ndarray, pc:
     lb = (0.5 * (f[:-1] + f[1:] - vr * dt[:, None])).min(axis=0)
     with np.errstate(invalid="ignore"):
         return lb > need + 0.5 * lip * float(dt.max()) + 1e-9 * (1.0 + need + lip)
+
+
+def _start_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, grid: np.ndarray,
+                  gc: np.ndarray, pc: np.ndarray, vr: float, reach0: float) -> np.ndarray:
+    """A lower bound of each obstacle's first uncertified grid time in :func:`_predict_uncached`
+    (inf: it has none), for the pacing (waypoints) discs of fixed size from one interpolation of
+    all their tracks at the coarse times, -inf for the others. Before the first coarse interval
+    whose bound is <= reach + L dt_max / 2 (+ 1e-9 m, far above the interpolations' rounding),
+    the gap exceeds reach + L dt_max / 2, so no fine interval there is uncertified."""
+    n = len(obstacles)
+    out = np.full(n, -math.inf)
+    out[far] = math.inf
+    if len(gc) < 2:
+        return out
+    dt = np.diff(gc)
+    half_fine = 0.5 * float(np.diff(grid).max())
+    groups: dict[int, list[int]] = {}
+    for k, o in enumerate(obstacles):
+        if not far[k] and o.growth is None and isinstance(o.motion, WaypointMotion):
+            groups.setdefault(len(o.motion.keyframes), []).append(k)
+    for ks in groups.values():
+        kf = np.stack([obstacles[k].motion.keyframes for k in ks])  # type: ignore[attr-defined]
+        tm = np.mod(gc[None, :], kf[:, -1, 0][:, None])  # (obstacles, coarse times)
+        i = np.clip((kf[:, None, :, 0] <= tm[:, :, None]).sum(axis=2) - 1, 0, kf.shape[1] - 2)
+        a = np.take_along_axis(kf, i[:, :, None].repeat(3, axis=2), axis=1)
+        b = np.take_along_axis(kf, (i + 1)[:, :, None].repeat(3, axis=2), axis=1)
+        w = np.clip((tm - a[:, :, 0]) / (b[:, :, 0] - a[:, :, 0]), 0.0, 1.0)
+        d = np.hypot(pc[None, :, 0] - (a[:, :, 1] + w * (b[:, :, 1] - a[:, :, 1])),
+                     pc[None, :, 1] - (a[:, :, 2] + w * (b[:, :, 2] - a[:, :, 2])))
+        sel = np.array(ks)
+        lip = np.array([vr + _track(obstacles[k])[1] for k in ks])
+        need = (reach0 + np.array([obstacles[k].radius for k in ks]) + lip * half_fine
+                + 1e-9 * (1.0 + reach0 + lip))
+        low = 0.5 * (d[:, :-1] + d[:, 1:] - lip[:, None] * dt[None, :]) <= need[:, None]
+        first = np.argmax(low, axis=1)
+        out[sel] = np.where(low.any(axis=1), gc[first], math.inf)
+    return out
 
 
 def first_collision(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], robot_radius: float,
