@@ -463,7 +463,7 @@ def capsule_buried(ax: float, ay: float, bx: float, by: float, pad: float,
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def points_clearance(px: np.ndarray, py: np.ndarray, obs: ObstacleArrays) -> np.ndarray:
     """Vectorised :func:`point_clearance`, shape (N,)."""
     out = np.empty(px.shape[0])
@@ -472,7 +472,7 @@ def points_clearance(px: np.ndarray, py: np.ndarray, obs: ObstacleArrays) -> np.
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def points_clear(px: np.ndarray, py: np.ndarray, obs: ObstacleArrays, limit: float) -> np.ndarray:
     """Mask (N,): the exact clearance of each point is >= ``limit`` [m] (pass/fail only)."""
     out = np.empty(px.shape[0], dtype=np.bool_)
@@ -482,7 +482,7 @@ def points_clear(px: np.ndarray, py: np.ndarray, obs: ObstacleArrays, limit: flo
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def segments_clearance(ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray,
                        obs: ObstacleArrays, stop_below: float) -> np.ndarray:
     """Vectorised :func:`segment_clearance`, shape (N,)."""

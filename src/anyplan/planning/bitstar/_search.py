@@ -127,7 +127,7 @@ def _expand(v: int, p: Points, t: Tree, q: SearchQueue, b: Batch, pr: np.ndarray
     q.ne[0] = es
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def iterate(p: Points, t: Tree, q: SearchQueue, b: Batch, pr: np.ndarray, obs: ObstacleArrays,
             limit: float, max_iter: int) -> int:
     """Run the batch ``b`` for up to ``max_iter`` units of work (edge pops plus vertex
@@ -227,7 +227,7 @@ def iterate(p: Points, t: Tree, q: SearchQueue, b: Batch, pr: np.ndarray, obs: O
     return BUDGET
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def start_batch(p: Points, t: Tree, q: SearchQueue, b: Batch, pr: np.ndarray) -> None:
     """Batch ``b`` starts: clear both queues, mark all vertices old and queue the useful ones.
 
