@@ -26,6 +26,7 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -148,6 +149,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=int, default=1)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=None, help="also write the Markdown report here")
+    ap.add_argument("--rows", default=None, help="also write every run's row as JSON here")
     a = ap.parse_args(argv)
     from anyplan.agents.base import AGENTS
     from anyplan.experiments.dynabarn import parse_worlds
@@ -200,6 +202,9 @@ def main(argv: list[str] | None = None) -> int:
                    "crowds tracked >= 95 % success and 0 robot-caused collisions; planning <= 20 ms "
                    "median, <= 50 ms p95 per call with up to 60 people; ahead of dovs and orca.", ""]
         print("\n".join(report[-5:]))
+        if a.rows:
+            Path(a.rows).write_text(json.dumps([{k: (str(v) if k == "status" else v) for k, v in r.items()}
+                                                for r in rows]))
     if a.out:
         Path(a.out).write_text("\n".join(report) + "\n")
     return 0

@@ -111,6 +111,10 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         plan_extra_m: With such predictions, paths are planned and timed against discs whose
             extra radius is capped at this [m]; the safety guard checks every motion against
             the full growth (free to rest, or stoppable) before it starts. None: no cap.
+        guard: ``"growth"``: the horizon and the guard apply to uncertain discs (``tracked``),
+            exact twists (``twist``) are planned against in full; ``"horizon"``: both apply to
+            every prediction without an announced motion; ``"never"``: the horizon without the
+            guard.
         **kwargs: Further options of :class:`SequentialBITStarAgent` (planning_delay, ...).
     """
 
@@ -247,6 +251,15 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             out.append(o)
         return out
 
+    def _certain(self, preds: list[PredictedObstacle]) -> list[PredictedObstacle]:
+        """With ``guard="growth"``, exact-twist predictions (no uncertain disc: ``twist``
+        perception) are planned against in full, as announced ones (no horizon): measured on
+        DynaBARN, the receding horizon helped only with uncertain discs."""
+        if (self.guard_mode != "growth" or not preds
+                or any(o.growth is not None or o.until == math.inf for o in preds)):
+            return preds
+        return [dataclasses.replace(o, until=math.inf) for o in preds]
+
     def _guarded_by(self, safe: list[PredictedObstacle]) -> bool:
         """Whether the safety guard decides what starts: predictions with uncertain discs
         (``guard="growth"``, tracked perception), any with a horizon (``"horizon"``), or never."""
@@ -332,6 +345,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
         dt, d, t_ready, state = self._begin_replan(obs)
         t = obs.t
+        preds = self._certain(preds)
         safe = self._planning_preds(preds, np.array([state.x, state.y]), t_ready)
         uncertain = safe is not preds
         preds = self._capped(safe) if uncertain else preds
@@ -432,6 +446,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 and t - self._last_replan >= self.min_replan_interval_s):
             self._replan(obs, preds, "holding")
             return
+        preds = self._certain(preds)
         safe = self._planning_preds(preds, np.array([obs.robot.x, obs.robot.y]), t)
         if safe is not preds:
             preds = self._capped(safe)
