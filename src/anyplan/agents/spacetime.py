@@ -163,6 +163,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         self._shapes: list[Shape] = []
         self._preds: list[PredictedObstacle] = []
         self._rows: RowCache | None = None
+        #: Nominal motions of this replanning and whether each is free as timed (``_timed_fn``).
+        self._nominals: dict[tuple[Any, ...], tuple[Trajectory, bool | None, list[Shape]]] = {}
 
     def _new_record(self) -> SpaceTimeStats:
         return SpaceTimeStats()
@@ -179,15 +181,27 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         def build(path: np.ndarray, shapes: Sequence[Shape], delay: float) -> Trajectory:
             if delay == 0.0:
                 self._tried.append((np.asarray(path), list(shapes)))
-            nominal = nominal_fn(path, shapes, delay)
+            # The same path, squares and start again (the long waits on a path already tried):
+            # the same nominal motion and the same check, not smoothed and checked again.
+            key = (t_start, state.x, state.y, state.theta, state.v, state.omega, delay,
+                   np.asarray(path, dtype=float).tobytes(), tuple(id(s) for s in shapes))
+            memo = self._nominals.get(key)
+            if memo is None or any(a is not b for a, b in zip(memo[2], shapes, strict=True)):
+                nominal = nominal_fn(path, shapes, delay)
+                free = None
+                if nominal.certified_free and delay == 0.0 and self._preds:
+                    free = verify(nominal, self._preds, spec.radius, margin=cfg.margin,
+                                  t_until=nominal.t_end) is None
+                memo = (nominal, free, list(shapes))
+                self._nominals[key] = memo
+            nominal, free = memo[0], memo[1]
             if not nominal.certified_free:
                 return nominal  # a best effort that cuts an obstacle: never a candidate
             if delay > 0.0 or not self._preds:
                 if not self._preds:
                     self._cands.append((nominal.t_end, nominal, np.asarray(path), list(shapes)))
                 return nominal
-            if verify(nominal, self._preds, spec.radius, margin=cfg.margin,
-                      t_until=nominal.t_end) is None:
+            if free:
                 # Already free as timed for the static world (time-optimal): nothing to re-time.
                 self._cands.append((nominal.t_end, nominal, np.asarray(path), list(shapes)))
                 return nominal
@@ -353,6 +367,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         self._tried = []
         self._preds = list(preds)
         self._rows = None
+        self._nominals = {}
         w0 = time.perf_counter()
         res: SequentialResult | None = None
         if self._path is not None and len(self._path) >= 2:
