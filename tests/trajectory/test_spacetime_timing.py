@@ -110,6 +110,26 @@ def test_shared_rows_give_the_same_map_on_their_grid_and_a_conservative_one_off_
             assert (d - r[None, :]).min() > reach
 
 
+def test_stacked_rows_are_each_obstacles_rows_and_name_the_blockers():
+    # RowCache.rows_all (every obstacle's rows at once, what build_stmap asks for) holds each
+    # obstacle's own rows, over a growing horizon; the map names the obstacles that mark it
+    # (not the one that stays away), with and without the cache, in the order given.
+    ob = PredictedObstacle("X", 0.3, UnicycleMotion(5.0, -1.3, np.pi / 2, 0.3))
+    grow = Growing("G", UnicycleMotion(3.0, 5.0, -np.pi / 2, 0.2), 0.3, 0.02)
+    far = PredictedObstacle("F", 0.3, UnicycleMotion(5.0, 40.0, 0.0, 0.3))
+    rows = RowCache(1.0, 0.05)
+    for j0, j1 in ((0, 300), (10, 700), (0, 120), (5, 1500)):
+        qx, qy, r = rows.rows_all([grow, far, ob], j0, j1)
+        for k, o in enumerate((grow, far, ob)):
+            q1, r1 = RowCache(1.0, 0.05).rows(o, j0, j1)
+            assert np.array_equal(qx[k], q1[:, 0]) and np.array_equal(qy[k], q1[:, 1])
+            assert np.array_equal(r[k], r1)
+    for cache in (None, rows):
+        m = build_stmap(_pts, 8.0, [grow, far, ob], SPEC.radius, 1.25, 25.0, margin=0.05,
+                        rows=cache)
+        assert m.blockers == ["G", "X"]
+
+
 def test_retimed_motion_passes_behind_and_is_certified_free():
     tr = _straight()
     ob = _crossing()

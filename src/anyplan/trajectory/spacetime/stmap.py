@@ -89,6 +89,7 @@ class RowCache:
     def __init__(self, t_origin: float, h: float) -> None:
         self.t_origin, self.h = float(t_origin), float(h)
         self._rows: dict[int, tuple[Any, int, int, np.ndarray, np.ndarray]] = {}
+        self._stack: tuple[list[Any], int, int, np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def first_row(self, t: float) -> int:
         """Index j of the row that contains time ``t`` [s]."""
@@ -113,6 +114,33 @@ class RowCache:
             e = (o, a, b, q, r_max)
             self._rows[id(o)] = e
         return e[3][j0 - e[1]:j1 - e[1]], e[4][j0 - e[1]:j1 - e[1]]
+
+    def rows_all(self, obstacles: Sequence[Any], j0: int, j1: int
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`rows` of every obstacle, stacked: centres' x and y (n, j1 - j0) [m] and
+        largest radii (n, j1 - j0) [m]. The stack of the last list of obstacles is kept (the
+        maps of one replanning ask for the same ones), over rows to spare like :meth:`rows`."""
+        st = self._stack
+        if (st is None or len(st[0]) != len(obstacles)
+                or any(a is not b for a, b in zip(st[0], obstacles, strict=True))
+                or not (st[1] <= j0 and j1 <= st[2])):
+            a, b = j0, j1
+            if st is not None and len(st[0]) == len(obstacles) and all(
+                    x is y for x, y in zip(st[0], obstacles, strict=True)):
+                a, b = min(st[1], j0), max(st[2], j1)
+            parts = [self.rows(o, a, b) for o in obstacles]
+            # the rows each obstacle's entry holds (rows to spare included) bound the stack
+            lo = max(self._rows[id(o)][1] for o in obstacles)
+            hi = min(self._rows[id(o)][2] for o in obstacles)
+            if lo <= a and b <= hi:
+                parts = [self.rows(o, lo, hi) for o in obstacles]
+                a, b = lo, hi
+            q = np.stack([p[0] for p in parts])
+            st = (list(obstacles), a, b, np.ascontiguousarray(q[:, :, 0]),
+                  np.ascontiguousarray(q[:, :, 1]), np.stack([p[1] for p in parts]))
+            self._stack = st
+        i0, i1 = j0 - st[1], j1 - st[1]
+        return st[3][:, i0:i1], st[4][:, i0:i1], st[5][:, i0:i1]
 
 
 class STMap:
@@ -183,30 +211,28 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     n_free = int(math.floor(max(length - free_tail_m, 0.0) / ds)) if free_tail_m > 0.0 else ncell
     gx, gy = float(px.mean()), float(py.mean())
     grad = float(np.max(np.hypot(px - gx, py - gy)))
-    if rows is None:
+    obstacles = list(obstacles)
+    blockers: list[str] = []
+    if not obstacles:
+        return STMap(out, t_map, h, ds, length, blockers)
+    if rows is not None:
+        qx, qy, r_max = rows.rows_all(obstacles, j_first, j_first + nrow)
+    else:
         t_edges = t_map + h * np.arange(nrow + 1)
         t_mid = t_map + h * (np.arange(nrow) + 0.5)
-    near: list[Any] = []
-    qs: list[np.ndarray] = []
-    reaches: list[np.ndarray] = []
-    for o in obstacles:
-        if rows is not None:
-            q, r_max = rows.rows(o, j_first, j_first + nrow)
-        else:
-            q = np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2)
-            r_edge = radii_at(o, t_edges)
-            r_max = np.maximum(radii_at(o, t_mid), np.maximum(r_edge[:-1], r_edge[1:]))
-        reach = robot_radius + r_max + margin + 0.5 * ds + 0.5 * float(o.max_speed) * h
-        if float(np.min(np.hypot(q[:, 0] - gx, q[:, 1] - gy) - grad - reach)) > 0.0:
-            continue  # never near the path
-        near.append(o)
-        qs.append(q)
-        reaches.append(reach)
-    blockers: list[str] = []
-    if near:
-        q_all = np.stack(qs)
-        hit = _fill(out, px, py, cx, cy, crad, np.ascontiguousarray(q_all[:, :, 0]),
-                    np.ascontiguousarray(q_all[:, :, 1]), np.ascontiguousarray(np.stack(reaches)),
-                    np.array([float(o.max_speed) * h for o in near]), _CHUNK, n_free)
-        blockers = [str(o.name) for o, hh in zip(near, hit, strict=True) if hh]
+        q = np.stack([np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2) for o in obstacles])
+        qx, qy = q[:, :, 0], q[:, :, 1]
+        r_edges = np.stack([radii_at(o, t_edges) for o in obstacles])
+        r_mid = np.stack([radii_at(o, t_mid) for o in obstacles])
+        r_max = np.maximum(r_mid, np.maximum(r_edges[:, :-1], r_edges[:, 1:]))
+    speed = np.array([float(o.max_speed) for o in obstacles])
+    # All obstacles at once, element by element the same operations as one at a time.
+    reach = robot_radius + r_max + margin + 0.5 * ds + (0.5 * speed)[:, None] * h
+    away = np.min(np.hypot(qx - gx, qy - gy) - grad - reach, axis=1) > 0.0  # never near the path
+    near = np.flatnonzero(~away)
+    if len(near):
+        hit = _fill(out, px, py, cx, cy, crad, np.ascontiguousarray(qx[near]),
+                    np.ascontiguousarray(qy[near]), np.ascontiguousarray(reach[near]),
+                    speed[near] * h, _CHUNK, n_free)
+        blockers = [str(obstacles[k].name) for k, hh in zip(near, hit, strict=True) if hh]
     return STMap(out, t_map, h, ds, length, blockers)
