@@ -171,3 +171,29 @@ def test_capped_search_gives_the_exhaustive_answer(seed):
         if a is not None and b is not None:
             for f in ("t", "s", "v", "a"):
                 assert np.array_equal(getattr(a, f), getattr(b, f))
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_goal_bounds_on_the_reachable_cells_only_give_the_same_answer(seed):
+    # goal_times computed only on the cells a motion from the start can be in (frontier=True):
+    # on random maps, with start speeds off the lattice, a map starting before t0 and coarse
+    # keys, the plan is the one with every cell computed, bit for bit.
+    rng = np.random.default_rng(300 + seed)
+    length = float(rng.uniform(1.0, 5.0))
+    vm, am = 1.0, 0.8  # a cell a row at top speed: the frontier matters
+    x0, x1 = _caps(length, vm * vm)
+    forbidden = np.zeros((int(rng.integers(150, 400)), len(x0)), dtype=bool)
+    for _ in range(int(rng.integers(2, 10))):
+        c, j = rng.integers(0, len(x0) - 3), rng.integers(0, forbidden.shape[0] - 10)
+        forbidden[j:j + rng.integers(5, 120), c:c + rng.integers(1, 8)] = True
+    forbidden[:4, :3] = False
+    t_map = -float(rng.uniform(0.0, H)) if seed % 2 else 0.0
+    v0 = 0.0 if seed % 3 == 0 else float(rng.uniform(0.0, vm))
+    for key in (0, 4):
+        a, b = (plan_velocity(forbidden, t_map, H, DS, x0, x1, length, 0.0, v0, am, vm,
+                              horizon_s=forbidden.shape[0] * H + t_map, key_cells=key,
+                              frontier=f) for f in (True, False))
+        assert (a is None) == (b is None)
+        if a is not None and b is not None:
+            for f in ("t", "s", "v", "a"):
+                assert np.array_equal(getattr(a, f), getattr(b, f))

@@ -82,7 +82,7 @@ def to_go(d: float, v: float, a: float, v_max: float) -> float:
 
 @njit(cache=True)
 def goal_times(forbidden: np.ndarray, t_map: float, h: float, c_goal: int, reach: int,
-               ds: float, v_max: float) -> np.ndarray:
+               ds: float, v_max: float, c_first: int = -1) -> np.ndarray:
     """Lower bounds G[j, c] [s] on the arrival at the goal cell from cell c at time t_map + j h.
 
     The relaxation of every lattice motion: within a row the robot advances by at most ``reach``
@@ -90,6 +90,12 @@ def goal_times(forbidden: np.ndarray, t_map: float, h: float, c_goal: int, reach
     acceleration; each bound is also raised to the distance bound t + (c_goal - c - 1) ds / v_max
     (the max of two lower bounds is one). Backward over the rows; inf marks cells from which the
     goal cannot be reached within the map (the search drops them).
+
+    With ``c_first >= 0`` only the cells c <= c_first + j reach of row j are computed (the others
+    stay inf): row j reads row j + 1 up to c + reach only, so the computed cells get the same
+    values; :func:`~anyplan.trajectory.spacetime.lattice.plan_velocity` passes a c_first beyond
+    every cell a motion from the start can be in during row 0 (then during row j too, as
+    v_max h / ds < reach): the search reads no other cell.
     """
     nrow, ncell = forbidden.shape
     g = np.full((nrow + 1, ncell), np.inf)
@@ -97,7 +103,8 @@ def goal_times(forbidden: np.ndarray, t_map: float, h: float, c_goal: int, reach
         g[nrow, c] = t_map + nrow * h
     for j in range(nrow - 1, -1, -1):
         tj = t_map + j * h
-        for c in range(ncell):
+        c_end = ncell if c_first < 0 else min(ncell, c_first + j * reach + 1)
+        for c in range(c_end):
             if c >= c_goal:
                 g[j, c] = tj
                 continue

@@ -71,7 +71,8 @@ def lattice_dt(v_max: float, a_max: float, target_dt: float = 0.25) -> tuple[flo
 def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap0: np.ndarray,
                   xcap1: np.ndarray, length: float, t0: float, v0: float, a_max: float,
                   v_max: float, *, target_dt: float = 0.25, horizon_s: float = 60.0,
-                  key_cells: int = 4, cap: bool = True) -> VelocityPlan | None:
+                  key_cells: int = 4, cap: bool = True, frontier: bool = True
+                  ) -> VelocityPlan | None:
     """The earliest lattice motion from (t0, s=0, v0) to rest at (about) the path's end.
 
     Args:
@@ -95,6 +96,8 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
             (the exact lattice optimum).
         cap: End a search once no node left can arrive within the horizon (the same answer,
             sooner; False runs it to exhaustion, for tests).
+        frontier: Compute the goal-time bounds only on the cells a motion from the start can
+            reach (the same answer, sooner; False computes every cell, for tests).
 
     Returns:
         The :class:`VelocityPlan`, or None if no lattice motion reaches the end in the horizon.
@@ -122,8 +125,12 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
     c_goal = min(int(math.floor((length - 2.0 * delta) / ds)), ncell - 1)
     reach = int(math.ceil(v_max * h / ds)) + 1
     lm = LatticeMap(forbidden, float(t_map), float(h), float(ds), xcap0, xcap1)
+    # A motion from (t0, s = 0) is at s <= v_max (t - t0): during row j (t < t_map + (j+1) h)
+    # in a cell <= c_first + j (v_max h / ds) (2 cells to spare for rounding); goal_times
+    # computes only the cells the search can read (the same values there).
+    c_first = max(int(v_max * (t_map + h - t0) / ds) + 2, 0) if frontier else -1
     gt = goal_times(forbidden, float(t_map), float(h), max(c_goal, 0), reach, float(ds),
-                    float(v_max))
+                    float(v_max), c_first)
     best: VelocityPlan | None = None
     for t_a, s_a, k_a, acc0, tau0 in starts:
         m_goal = int(math.floor((length - s_a) / delta + 1e-9))
