@@ -39,7 +39,8 @@ CAP_DELTA = 0.05
 def _grown(a: np.ndarray, n: int) -> np.ndarray:
     """``a`` with twice the room, its first ``n`` entries kept."""
     out = np.empty(2 * max(a.shape[0], 1))
-    out[:n] = a[:n]
+    for i in range(n):  # not out[:n] = a[:n]: that compiles numba's error-message formatting
+        out[i] = a[i]
     return out
 
 
