@@ -72,7 +72,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     with compiling_notifier(_compiling_notice) as note:
         code = _run(args)
     if note.compiled:
-        sys.stderr.write(f"anyplan: compiled {note.count} kernel functions in {note.seconds:.1f} s "
+        what = f"{note.count} function" + ("s" if note.count != 1 else "")
+        sys.stderr.write(f"anyplan: compiled {what} in {note.seconds:.1f} s "
                          "(once: later runs load them from the cache)\n")
     return code
 
