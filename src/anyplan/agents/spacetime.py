@@ -9,8 +9,10 @@ within ``accept_s`` of the untimed arrival ends the search; otherwise the earlie
 wins. Every motion is verified (:func:`anyplan.trajectory.spacetime.verify`) before it is
 executed; when none is, the robot brakes to rest and holds (``extra.fallbacks``). The online
 timing policy is :class:`~anyplan.agents.replanning.ReplanningAgent`'s, shared with
-``seq-bitstar``. Statistics: :class:`~anyplan.agents.stats.SpaceTimeStats`. See
-``docs/spacetime.md``.
+``seq-bitstar``. With uncertain (tracked) predictions it plans on a receding horizon against
+capped discs, and the safety guard checks each motion against the full discs
+(``docs/perception.md``, "st-bitstar when the future is unknown"). Statistics:
+:class:`~anyplan.agents.stats.SpaceTimeStats`. See ``docs/spacetime.md``.
 """
 
 from __future__ import annotations
