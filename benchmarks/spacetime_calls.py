@@ -3,13 +3,13 @@
 Runs st-bitstar deterministically (``planning_delay=0.1, batches_per_plan=2, max_time_s=10``) on
 paper-1..3 (``--seeds`` seeds), the first ``--random`` scenarios of ``random_suite(0)``,
 ``gap_suite(0, n=--gaps)`` and ``--dynabarn`` of DynaBARN's medium and hard worlds (20-59, evenly
-spread; tracks announced, as in ``benchmarks/spacetime.py``), and records for every run its status, time to goal, executed
-trajectory and planned paths (a fingerprint), and the CPU time (``time.process_time``) of every
-planning call (``_replan``). With ``--trees A,B`` each repetition runs one worker process per
-tree, alternating, so that the load of the shared machine falls on both alike; it then tells
-whether the decisions are identical (``--mode deterministic``) and prints per suite the median
-and p95 per-call CPU times and their ratios B / A. ``--mode bench`` runs the benchmark's
-settings instead (BIT* on a time budget), for timing only.
+spread; tracks announced, as in ``benchmarks/spacetime.py``), and records for every run its
+status, time to goal, executed trajectory and planned paths (a fingerprint), and the CPU time
+(``time.process_time``) of every planning call (``_replan``). With ``--trees A,B`` each repetition
+runs one worker process per tree, alternating, so that the load of the shared machine falls on
+both alike; it then tells whether the decisions are identical (``--mode deterministic``) and
+prints per suite the median and p95 per-call CPU times and their ratios B / A. ``--mode bench``
+runs the benchmark's settings instead (BIT* on a time budget), for timing only.
 
 Usage::
 
