@@ -267,6 +267,16 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             out.append(o)
         return out
 
+    def _split(self, preds: list[PredictedObstacle], p: np.ndarray, t: float
+               ) -> tuple[list[PredictedObstacle], list[PredictedObstacle] | None]:
+        """The predictions planned and timed against from ``p`` at ``t`` [s], and the full
+        ones the safety guard checks (None when every prediction is certain: no guard)."""
+        preds = self._certain(preds)
+        safe = self._planning_preds(preds, p, t)
+        if safe is preds:
+            return preds, None
+        return self._capped(safe), safe
+
     def _certain(self, preds: list[PredictedObstacle]) -> list[PredictedObstacle]:
         """With ``guard="growth"``, exact-twist predictions (no uncertain disc: ``twist``
         perception) are planned against in full, as announced ones (no horizon): measured on
@@ -361,10 +371,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
         dt, d, t_ready, state = self._begin_replan(obs)
         t = obs.t
-        preds = self._certain(preds)
-        safe = self._planning_preds(preds, np.array([state.x, state.y]), t_ready)
-        uncertain = safe is not preds
-        preds = self._capped(safe) if uncertain else preds
+        preds, safe = self._split(preds, np.array([state.x, state.y]), t_ready)
+        uncertain = safe is not None
         self._cands = []
         self._tried = []
         self._preds = list(preds)
@@ -407,7 +415,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         # really have, on the same path (no new search).
         t_switch, motion = self._take_up(obs, t_ready, wall, d, dt, motion,
                                          lambda state, t_s: self._retime_path(state, t_s, path, shapes))
-        if uncertain and self._guarded_by(safe):
+        if safe is not None and self._guarded_by(safe):
             kind, motion = self._guard(obs, t_switch, motion, safe, res.status)
             if kind == "keep":
                 return
@@ -463,14 +471,11 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 and t - self._last_replan >= self.min_replan_interval_s):
             self._replan(obs, preds, "holding")
             return
-        preds = self._certain(preds)
-        safe = self._planning_preds(preds, np.array([obs.robot.x, obs.robot.y]), t)
-        if safe is not preds:
-            preds = self._capped(safe)
-            if self._guarded_by(safe) and not self.guard.still_safe(traj, safe, t,
-                                                                   self.check_period_s + 0.1):
-                self._replan(obs, preds, "safety: the motion in use can no longer stop in time")
-                return
+        preds, safe = self._split(preds, np.array([obs.robot.x, obs.robot.y]), t)
+        if safe is not None and self._guarded_by(safe) and not self.guard.still_safe(
+                traj, safe, t, self.check_period_s + 0.1):
+            self._replan(obs, preds, "safety: the motion in use can no longer stop in time")
+            return
         hit = verify(traj, preds, spec.radius, t_from=t,
                      t_until=min(max(traj.t_end, t) + 1.0, t + _CHECK_HORIZON_S),
                      margin=0.5 * self.config.margin)

@@ -205,27 +205,26 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
     ic = np.unique(np.r_[np.arange(0, len(grid), _COARSE), len(grid) - 1])
     gc, pc = grid[ic], p[ic]
     far = _far_from_tracks(obstacles, gc, pc, vr, robot_radius + margin + extra)
+
+    def gap_bounds(o: PredictedObstacle, ts: np.ndarray, ps: np.ndarray) -> np.ndarray:
+        """Lower bounds of the gap between the robot (at ``ps``) and ``o`` on each interval
+        of ``ts``; with growth, the gap to the grown disc, its slope adding the growth rate."""
+        d = np.hypot(*(ps - o.positions(ts)).T)
+        rate = 0.0
+        if o.growth is not None:
+            d = d - o.growth.at(ts)
+            rate = o.growth.rate
+        return 0.5 * (d[:-1] + d[1:] - (vr + o.max_speed + rate) * np.diff(ts))
+
     def start(k: int) -> float | None:
         """The obstacle's first uncertified grid time, or None if it is certified clear."""
         o = obstacles[k]
         if o.until < t0 or far[k]:
             return None  # predicted only before the interval, or never near the robot
         reach = robot_radius + o.radius + margin + extra
-        if len(ic) < len(grid):
-            d = np.hypot(*(pc - o.positions(gc)).T)
-            rate = 0.0
-            if o.growth is not None:
-                d = d - o.growth.at(gc)
-                rate = o.growth.rate
-            if np.all(0.5 * (d[:-1] + d[1:] - (vr + o.max_speed + rate) * np.diff(gc)) > reach):
-                return None
-        d = np.hypot(*(p - o.positions(grid)).T)
-        rate = 0.0
-        if o.growth is not None:  # the gap to the grown disc; its slope adds the growth rate
-            d = d - o.growth.at(grid)
-            rate = o.growth.rate
-        lb = 0.5 * (d[:-1] + d[1:] - (vr + o.max_speed + rate) * np.diff(grid))
-        bad = np.flatnonzero(lb <= reach)
+        if len(ic) < len(grid) and np.all(gap_bounds(o, gc, pc) > reach):
+            return None
+        bad = np.flatnonzero(gap_bounds(o, grid, p) <= reach)
         if o.until < t1:  # intervals that start after the prediction's horizon do not count
             bad = bad[grid[bad] <= o.until]
         return float(grid[bad[0]]) if len(bad) else None

@@ -121,12 +121,11 @@ class RowCache:
         largest radii (n, j1 - j0) [m]. The stack of the last list of obstacles is kept (the
         maps of one replanning ask for the same ones), over rows to spare like :meth:`rows`."""
         st = self._stack
-        if (st is None or len(st[0]) != len(obstacles)
-                or any(a is not b for a, b in zip(st[0], obstacles, strict=True))
-                or not (st[1] <= j0 and j1 <= st[2])):
+        same = st is not None and len(st[0]) == len(obstacles) and all(
+            x is y for x, y in zip(st[0], obstacles, strict=True))
+        if st is None or not same or not (st[1] <= j0 and j1 <= st[2]):
             a, b = j0, j1
-            if st is not None and len(st[0]) == len(obstacles) and all(
-                    x is y for x, y in zip(st[0], obstacles, strict=True)):
+            if st is not None and same:
                 a, b = min(st[1], j0), max(st[2], j1)
             parts = [self.rows(o, a, b) for o in obstacles]
             # the rows each obstacle's entry holds (rows to spare included) bound the stack
