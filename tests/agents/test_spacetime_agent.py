@@ -174,3 +174,38 @@ def test_guard_option():
     assert make_agent("st-bitstar", guard="never").guard_mode == "never"
     with pytest.raises(ValueError, match="guard"):
         make_agent("st-bitstar", guard="sometimes")
+
+
+def test_guard_of_a_safety_replanning_checks_the_full_discs():
+    # When the motion in use can no longer stop before an uncertain disc, the replanning's guard
+    # decides against the disc's full growth (1.0 m here), not the one capped at plan_extra_m
+    # (0.3 m) that paths are planned and timed against.
+    from anyplan.agents.base import Observation
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.prediction.base import RadiusGrowth
+    from anyplan.world import RobotState, UnicycleMotion
+
+    sc = scenario_from_dict({**_crossing_scenario().to_dict(), "dynamic_obstacles": []})
+    agent = make_agent("st-bitstar", planning_delay=0.1)
+    agent.reset(sc, np.random.default_rng(0))
+    for t0 in (0.0, 0.1):  # the first plan, taken up after the planning delay
+        agent.act(Observation(t0, RobotState(1.0, 3.0, 0.0, 0.0, 0.0)))
+    t = 6.0
+    assert agent.trajectory is not None and agent.trajectory.t_end > t + 2.0
+    st = agent.trajectory.state(t)
+    assert st.v > 0.3  # cruising towards the goal
+    growth = RadiusGrowth(t, np.array([0.0, 1.0, 3.0]), np.array([0.1, 0.6, 1.0]))
+    towards = UnicycleMotion(st.x + 1.2, st.y, math.pi, 0.3, 0.0, start_time=t)
+    ahead = PredictedObstacle("A", 0.25, towards, growth, until=t + 3.0)
+    seen = []
+    decide = agent.guard.decide
+
+    def spy(t_s, motion, current, state, preds, commit):
+        seen.append(list(preds))
+        return decide(t_s, motion, current, state, preds, commit)
+
+    agent.guard.decide = spy
+    agent._check(Observation(t, st), [ahead])
+    assert agent.record.reasons[-1].startswith("safety")
+    assert seen, "the guard decided nothing"
+    assert max(o.growth.max_extra for o in seen[0]) == pytest.approx(1.0)

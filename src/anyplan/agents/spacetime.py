@@ -471,12 +471,14 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 and t - self._last_replan >= self.min_replan_interval_s):
             self._replan(obs, preds, "holding")
             return
-        preds, safe = self._split(preds, np.array([obs.robot.x, obs.robot.y]), t)
+        # ``_replan`` is given the predictions as observed (``preds``): it splits them itself,
+        # so that its guard checks the full discs, not the capped ones planned against.
+        planned, safe = self._split(preds, np.array([obs.robot.x, obs.robot.y]), t)
         if safe is not None and self._guarded_by(safe) and not self.guard.still_safe(
                 traj, safe, t, self.check_period_s + 0.1):
             self._replan(obs, preds, "safety: the motion in use can no longer stop in time")
             return
-        hit = verify(traj, preds, spec.radius, t_from=t,
+        hit = verify(traj, planned, spec.radius, t_from=t,
                      t_until=min(max(traj.t_end, t) + 1.0, t + _CHECK_HORIZON_S),
                      margin=0.5 * self.config.margin)
         if hit is None:
