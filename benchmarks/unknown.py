@@ -20,7 +20,10 @@ Usage::
 
     python benchmarks/unknown.py [--only dynabarn,crowds,gaps,prediction] [--modes twist,tracked]
         [--planners st-bitstar,seq-bitstar,dovs,orca] [--worlds 20-59] [--windows 9] [--seeds 1]
-        [--jobs 2]
+        [--jobs 2] [--set [PLANNER:]KEY=VALUE ...] [--deterministic]
+
+``--set`` and ``--deterministic`` are ``anyplan bench``'s (agent settings; a fixed planning delay
+and budgets, so that a run depends only on its scenario, settings and seed, not on the load).
 """
 
 from __future__ import annotations
@@ -40,16 +43,16 @@ if not SHARED.is_dir():
     SHARED = Path("/work/shared/benchmarks")
 
 
-def _run(task: tuple[str, dict[str, Any], str, str, int]) -> dict[str, Any]:
+def _run(task: tuple[str, dict[str, Any], str, str, int, dict[str, Any]]) -> dict[str, Any]:
     from anyplan.agents import make_agent
     from anyplan.simulation import simulate
     from anyplan.simulation.perception import override_sensing
     from anyplan.world.scenario import scenario_from_dict
 
-    suite, data, planner, mode, seed = task
+    suite, data, planner, mode, seed, config = task
     sc = override_sensing(scenario_from_dict(data, f"<{data['name']}>"), mode)
     try:
-        res = simulate(sc, make_agent(planner), seed=seed)
+        res = simulate(sc, make_agent(planner, **config), seed=seed)
     except Exception as exc:  # noqa: BLE001 - a planner failure is a result, reported
         return {"suite": suite, "mode": mode, "planner": planner, "scenario": sc.name,
                 "status": f"error: {type(exc).__name__}", "times": []}
@@ -150,6 +153,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=None, help="also write the Markdown report here")
     ap.add_argument("--rows", default=None, help="also write every run's row as JSON here")
+    from anyplan.cli.agent_options import add_agent_options, bench_configs
+
+    add_agent_options(ap, bench=True)  # --set [PLANNER:]KEY=VALUE, --deterministic (as anyplan bench)
     a = ap.parse_args(argv)
     from anyplan.agents.base import AGENTS
     from anyplan.experiments.dynabarn import parse_worlds
@@ -165,6 +171,7 @@ def main(argv: list[str] | None = None) -> int:
             planners.append(p)
         except ImportError:
             print(f"skipping {p}: not installed", file=sys.stderr)
+    configs = bench_configs(a, planners)
     report = [f"# benchmarks/unknown.py ({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())})",
               "", "Command: `python benchmarks/unknown.py " + " ".join(sys.argv[1:] if argv is None
                                                                      else argv) + "`", ""]
@@ -174,13 +181,14 @@ def main(argv: list[str] | None = None) -> int:
     tasks = []
     if "dynabarn" in only:
         for d in _dynabarn(parse_worlds(a.worlds)):
-            tasks += [("dynabarn", d, p, m, s) for m in modes for p in planners for s in range(a.seeds)]
+            tasks += [("dynabarn", d, p, m, s, configs[p]) for m in modes for p in planners
+                      for s in range(a.seeds)]
     if "crowds" in only:
         for tag, d in _crowds(a.windows):
-            tasks += [(tag, d, p, "tracked", s) for p in planners for s in range(a.seeds)]
+            tasks += [(tag, d, p, "tracked", s, configs[p]) for p in planners for s in range(a.seeds)]
     if "gaps" in only:
         for d in _gaps(a.gaps):
-            tasks += [("gaps", d, p, "tracked", s) for p in planners for s in range(a.seeds)]
+            tasks += [("gaps", d, p, "tracked", s, configs[p]) for p in planners for s in range(a.seeds)]
     rows = []
     t0 = time.perf_counter()
     if tasks:
