@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -209,3 +210,84 @@ def test_guard_of_a_safety_replanning_checks_the_full_discs():
     assert agent.record.reasons[-1].startswith("safety")
     assert seen, "the guard decided nothing"
     assert max(o.growth.max_extra for o in seen[0]) == pytest.approx(1.0)
+
+
+# A robot at 2 m/s heading +x, 1.2 m before a wall (x >= 2.2 m): it cannot brake to rest clear
+# of it (1 m of braking for a 0.34 m disc), and a spline turning off before the wall starts at
+# about 1 m/s. plan_motion then returns that spline as its best effort, ``feasible=False``:
+# the robot cannot take it up (as in DynaBARN world 53 at t = 1.3 s, at 1.5 m/s).
+_FAST = {"radius": 0.34, "v_max": 2.0, "omega_max": 2.0, "a_max": 2.0, "alpha_max": 4.0,
+         "goal_tolerance": 0.5}
+
+
+def _fast_at_a_wall():
+    return scenario_from_dict({
+        "name": "fast-at-a-wall", "time_limit": 30.0, "arena": {"width": 8.0, "height": 8.0},
+        "robot": {"start": [1.0, 1.0, 0.0], "goal": [1.5, 7.0], **_FAST},
+        "static_obstacles": [{"name": "W", "type": "rectangle", "center": [2.7, 4.0],
+                              "size": [1.0, 8.0], "angle": 0.0}],
+        "dynamic_obstacles": [{"name": "D", "start": [6.0, 7.0, math.pi], "v": 0.0,
+                               "radius": 0.3}]})
+
+
+def test_a_reference_the_robot_cannot_take_up_is_never_a_candidate():
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.world import RobotState, UnicycleMotion
+
+    agent = make_agent("st-bitstar")
+    agent.reset(_fast_at_a_wall(), np.random.default_rng(0))
+    state = RobotState(1.0, 1.0, 0.0, 2.0, 0.0)
+    agent._preds = [PredictedObstacle("D", 0.3, UnicycleMotion(6.0, 7.0, math.pi, 0.0))]
+    path = np.array([[1.0, 1.0], [1.4, 1.0], [1.4, 7.0]])
+    out = agent._timed_fn(state, 0.0, 3.0)(path, [], 0.0)
+    assert not out.feasible and out.state(0.0).v < 1.5  # the case: a best effort at ~1 m/s
+    assert agent._cands == []
+
+
+def test_the_motion_taken_up_starts_at_the_robots_speed():
+    # The replanning at 0 s plans from the state at 0.1 s on the motion in use (2 m/s towards
+    # the wall). Whatever it schedules (a new motion, or keeping the current one) must start at
+    # the robot's speed then: a reference that starts slower leaves the tracker behind (0.5 m
+    # in world 53, where Kanayama then reversed the robot into an obstacle).
+    from anyplan.agents.base import Observation
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.trajectory.trajectory import BrakeSegment, Trajectory
+    from anyplan.world import UnicycleMotion
+
+    sc = _fast_at_a_wall()
+    agent = make_agent("st-bitstar", **AGENTS.get("st-bitstar").deterministic_settings)
+    agent.reset(sc, np.random.default_rng(0))
+    spec = sc.robot
+    # Braking at a_max from 2.2 m/s: 2.0 m/s at (1.01, 1.0) at t = 0.1 s.
+    agent.trajectory = Trajectory([BrakeSegment(0.8, 1.0, 0.0, 2.2, 0.0, spec.a_max,
+                                                spec.alpha_max, 0.0)], kind="test")
+    preds = [PredictedObstacle("D", 0.3, UnicycleMotion(6.0, 7.0, math.pi, 0.0))]
+    before = agent.trajectory
+    agent._replan(Observation(0.0, before.state(0.0)), preds, "test")
+    t_switch, tr = agent.pending if agent.pending is not None else (0.1, agent.trajectory)
+    robot = before.state(t_switch)
+    assert robot.v == pytest.approx(2.0, abs=0.01)
+    assert abs(tr.state(t_switch).v - robot.v) <= 0.05
+    assert getattr(tr, "feasible", True)
+
+
+_DYNABARN = Path(__file__).resolve().parents[3] / "shared" / "benchmarks" / "dynabarn" / "worlds.json"
+
+
+@pytest.mark.skipif(not _DYNABARN.is_file(), reason="shared DynaBARN worlds.json not present")
+def test_dynabarn_53_known_motion_no_robot_caused_collision():
+    # World 53 with the obstacles' motions announced (oracle), deterministic settings: at 1.3 s
+    # the robot (1.5 m/s, 3 cm from a static obstacle) took up a reference starting at 0.03 m/s,
+    # overshot it by 0.5 m, and Kanayama reversed it into D20 at 4.05 s (-0.23 m/s).
+    from anyplan.experiments.dynabarn import load_worlds, world_to_scenario
+    from anyplan.simulation.perception import override_sensing
+
+    world = next(w for w in load_worlds(_DYNABARN) if w["world"] == 53)
+    sc = override_sensing(scenario_from_dict(world_to_scenario(world)), "oracle")
+    agent = make_agent("st-bitstar", **AGENTS.get("st-bitstar").deterministic_settings)
+    r = simulate(sc, agent, seed=0)
+    assert not r.collision_robot_caused
+    assert all(getattr(tr, "feasible", True) for _, tr in agent.executed)
+    # Every reference taken up starts at the speed the robot had on the one before.
+    for (_, prev), (ts, tr) in zip(agent.executed[:-1], agent.executed[1:], strict=True):
+        assert abs(tr.state(ts).v - prev.state(ts).v) <= 0.05

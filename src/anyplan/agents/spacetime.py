@@ -57,6 +57,13 @@ def _finite(x: float | None) -> float | None:
     return None if x is None or not math.isfinite(x) else float(x)
 
 
+def _followable(tr: Any) -> bool:
+    """Whether the robot can follow ``tr`` from its start state within its limits
+    (``feasible``) without cutting a static or virtual obstacle (``certified_free``): only
+    then is a prediction along ``tr`` one about where the robot goes."""
+    return bool(getattr(tr, "feasible", True)) and bool(getattr(tr, "certified_free", True))
+
+
 def warm_up_spacetime() -> None:
     """Load the s-t kernels once per process (outside any timed planning call)."""
     global _WARM
@@ -197,8 +204,11 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 memo = (nominal, free, list(shapes))
                 self._nominals[key] = memo
             nominal, free = memo[0], memo[1]
-            if not nominal.certified_free:
-                return nominal  # a best effort that cuts an obstacle: never a candidate
+            if not _followable(nominal):
+                # A best effort that cuts an obstacle, or that the robot cannot take up from its
+                # state (e.g. one starting at 0.03 m/s while the robot drives at 1.5 m/s):
+                # never a candidate, its check would not be about the motion executed.
+                return nominal
             if delay > 0.0 or not self._preds:
                 if not self._preds:
                     self._cands.append((nominal.t_end, nominal, np.asarray(path), list(shapes)))
@@ -406,7 +416,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         path, shapes = res.path, [v.shape for v in res.virtual_obstacles]
         if self._cands:
             _, motion, path, shapes = min(self._cands, key=lambda c: c[0])
-        elif res.collision_free and res.motion is not None:
+        elif res.collision_free and res.motion is not None and _followable(res.motion):
             motion = res.motion  # type: ignore[assignment]
         wall = time.perf_counter() - w0
         self._record_replan(t, wall, res, reason)
