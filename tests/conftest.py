@@ -45,3 +45,20 @@ def small_scenario_dict(**overrides):
     for k, v in overrides.items():
         d[k] = v
     return d
+
+
+def fast_at_a_wall_dict():
+    """A robot at (1, 1) heading +x with 2 m/s limits, a wall at x >= 2.2 m, goal (1.5, 7).
+
+    Driving +x at 2 m/s from (1, 1), the robot cannot brake to rest clear of the wall (1 m of
+    braking for a 0.34 m disc), and a spline turning off before it starts at about 1 m/s:
+    ``plan_motion`` returns that spline as its best effort, ``feasible=False``."""
+    return {
+        "name": "fast-at-a-wall", "time_limit": 30.0, "arena": {"width": 8.0, "height": 8.0},
+        "robot": {"start": [1.0, 1.0, 0.0], "goal": [1.5, 7.0], "radius": 0.34, "v_max": 2.0,
+                  "omega_max": 2.0, "a_max": 2.0, "alpha_max": 4.0, "goal_tolerance": 0.5},
+        "static_obstacles": [{"name": "W", "type": "rectangle", "center": [2.7, 4.0],
+                              "size": [1.0, 8.0], "angle": 0.0}],
+        "dynamic_obstacles": [{"name": "D", "start": [6.0, 7.0, 3.14159], "v": 0.0,
+                               "radius": 0.3}],
+    }

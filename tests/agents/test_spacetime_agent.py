@@ -14,6 +14,7 @@ from anyplan.experiments.gaps import WALL_T, WALL_X, gap_world, issue_gap_scenar
 from anyplan.planning.sequential import SequentialConfig
 from anyplan.simulation import simulate
 from anyplan.world.scenario import scenario_from_dict
+from tests.conftest import fast_at_a_wall_dict
 
 P3DX = {"radius": 0.3, "v_max": 0.4, "omega_max": 0.4, "a_max": 0.4, "alpha_max": 1.0,
         "goal_tolerance": 0.2}
@@ -212,22 +213,10 @@ def test_guard_of_a_safety_replanning_checks_the_full_discs():
     assert max(o.growth.max_extra for o in seen[0]) == pytest.approx(1.0)
 
 
-# A robot at 2 m/s heading +x, 1.2 m before a wall (x >= 2.2 m): it cannot brake to rest clear
-# of it (1 m of braking for a 0.34 m disc), and a spline turning off before the wall starts at
-# about 1 m/s. plan_motion then returns that spline as its best effort, ``feasible=False``:
-# the robot cannot take it up (as in DynaBARN world 53 at t = 1.3 s, at 1.5 m/s).
-_FAST = {"radius": 0.34, "v_max": 2.0, "omega_max": 2.0, "a_max": 2.0, "alpha_max": 4.0,
-         "goal_tolerance": 0.5}
-
-
+# The robot at 2 m/s before a wall (tests/conftest.py): plan_motion's best effort there starts
+# at about 1 m/s, ``feasible=False`` (as in DynaBARN world 53 at t = 1.3 s, at 1.5 m/s).
 def _fast_at_a_wall():
-    return scenario_from_dict({
-        "name": "fast-at-a-wall", "time_limit": 30.0, "arena": {"width": 8.0, "height": 8.0},
-        "robot": {"start": [1.0, 1.0, 0.0], "goal": [1.5, 7.0], **_FAST},
-        "static_obstacles": [{"name": "W", "type": "rectangle", "center": [2.7, 4.0],
-                              "size": [1.0, 8.0], "angle": 0.0}],
-        "dynamic_obstacles": [{"name": "D", "start": [6.0, 7.0, math.pi], "v": 0.0,
-                               "radius": 0.3}]})
+    return scenario_from_dict(fast_at_a_wall_dict())
 
 
 def test_a_reference_the_robot_cannot_take_up_is_never_a_candidate():
