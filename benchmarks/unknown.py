@@ -150,6 +150,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--windows", type=int, default=100, help="crowd windows per scene (and dense)")
     ap.add_argument("--gaps", type=int, default=10, help="gap worlds")
     ap.add_argument("--seeds", type=int, default=1)
+    ap.add_argument("--first-seed", type=int, default=0, help="seeds first-seed .. first-seed + seeds - 1")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=None, help="also write the Markdown report here")
     ap.add_argument("--rows", default=None, help="also write every run's row as JSON here")
@@ -179,16 +180,17 @@ def main(argv: list[str] | None = None) -> int:
         report += ["## Prediction on ETH/UCY", "", _prediction(), ""]
         print("\n".join(report), flush=True)
     tasks = []
+    seeds = range(a.first_seed, a.first_seed + a.seeds)
     if "dynabarn" in only:
         for d in _dynabarn(parse_worlds(a.worlds)):
             tasks += [("dynabarn", d, p, m, s, configs[p]) for m in modes for p in planners
-                      for s in range(a.seeds)]
+                      for s in seeds]
     if "crowds" in only:
         for tag, d in _crowds(a.windows):
-            tasks += [(tag, d, p, "tracked", s, configs[p]) for p in planners for s in range(a.seeds)]
+            tasks += [(tag, d, p, "tracked", s, configs[p]) for p in planners for s in seeds]
     if "gaps" in only:
         for d in _gaps(a.gaps):
-            tasks += [("gaps", d, p, "tracked", s, configs[p]) for p in planners for s in range(a.seeds)]
+            tasks += [("gaps", d, p, "tracked", s, configs[p]) for p in planners for s in seeds]
     rows = []
     t0 = time.perf_counter()
     if tasks:

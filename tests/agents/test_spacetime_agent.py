@@ -280,3 +280,58 @@ def test_dynabarn_53_known_motion_no_robot_caused_collision():
     # Every reference taken up starts at the speed the robot had on the one before.
     for (_, prev), (ts, tr) in zip(agent.executed[:-1], agent.executed[1:], strict=True):
         assert abs(tr.state(ts).v - prev.state(ts).v) <= 0.05
+
+def test_fallback_leaves_a_predicted_collision_rather_than_hold_in_it():
+    # A robot at rest, an uncertain obstacle heading at it (1 m/s, 3 m away): holding is struck
+    # by the disc planned against (capped at plan_extra_m); driving 1.5 m sideways touches only
+    # the full uncertainty disc (1.5 m of growth) while moving, and the planned disc never. The
+    # guard's own ranking holds (its moving part is trivially free); st-bitstar moves away.
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.prediction.base import RadiusGrowth
+    from anyplan.prediction.collision import first_collision
+    from anyplan.world import RobotState, UnicycleMotion
+
+    data = _crossing_scenario().to_dict()
+    data["robot"].update({"v_max": 1.0, "omega_max": 1.0, "a_max": 1.0, "alpha_max": 2.0})
+    data["dynamic_obstacles"] = []
+    agent = make_agent("st-bitstar")
+    agent.reset(scenario_from_dict(data), np.random.default_rng(0))
+    state = RobotState(4.0, 2.0, math.pi / 2, 0.0, 0.0)
+    growth = RadiusGrowth(0.0, np.array([0.0, 1.0, 3.0]), np.array([0.0, 0.5, 1.5]))
+    obst = [PredictedObstacle("F", 0.25, UnicycleMotion(7.0, 2.0, math.pi, 1.0), growth, until=3.0)]
+    dec = agent.guard.fallback(0.0, state, obst, "test")
+    assert dec.kind == "hold"
+    planned = agent._capped(obst)
+    r = agent.spec.radius
+    assert first_collision(dec.trajectory, planned, r, t_from=0.0, t_until=5.0) is not None
+    kind, tr, _ = agent._evasions(0.0, state, obst, None, dec)
+    assert kind != "hold" and tr.t_end > 0.5
+    # what it chose is free against the planned discs over the horizon ...
+    assert first_collision(tr, planned, r, t_from=0.0, t_until=5.0,
+                           margin=agent.guard.config.margin) is None
+    # ... and moves away from the obstacle's line
+    assert abs(tr.positions(np.array([tr.t_end]))[0][1] - 2.0) > 0.8
+
+
+def test_evasion_from_a_moving_robot_keeps_its_speed():
+    # A robot driving east at 1 m/s, an obstacle coming down across the point where it would
+    # brake to rest: braking, holding and every evasion that brakes first are struck; a smooth
+    # curve ahead from the robot's speed and heading passes in front of it.
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.prediction.collision import first_collision
+    from anyplan.world import RobotState, UnicycleMotion
+
+    data = _crossing_scenario().to_dict()
+    data["robot"].update({"v_max": 1.0, "omega_max": 1.0, "a_max": 1.0, "alpha_max": 2.0})
+    data["dynamic_obstacles"] = []
+    agent = make_agent("st-bitstar")
+    agent.reset(scenario_from_dict(data), np.random.default_rng(0))
+    state = RobotState(3.0, 3.0, 0.0, 1.0, 0.0)
+    down = [PredictedObstacle("D", 0.25, UnicycleMotion(3.5, 4.6, -math.pi / 2, 1.0), until=5.0)]
+    dec = agent.guard.fallback(0.0, state, down, "test")
+    assert not dec.safe  # whatever the guard picks (brake, turn away, back off) is struck moving
+    kind, tr, _ = agent._evasions(0.0, state, down, None, dec)
+    r, m = agent.spec.radius, agent.guard.config.margin
+    assert kind == "evade"
+    assert tr.state(0.2).v > 0.75  # it did not brake first
+    assert first_collision(tr, down, r, t_from=0.0, t_until=5.0, margin=m) is None

@@ -33,7 +33,7 @@ from anyplan.planning.sequential import MotionModel, SequentialConfig, Sequentia
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle, RadiusGrowth
 from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.kinds import ST_PREFIX, MotionKind
-from anyplan.trajectory.motion import polyline_trajectory
+from anyplan.trajectory.motion import plan_motion, polyline_trajectory
 from anyplan.trajectory.spacetime import RowCache, retime, verify
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import RobotState
@@ -334,19 +334,27 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
 
     def _evasions(self, t: float, state: RobotState, safe: list[PredictedObstacle],
                   motion: Trajectory | None, dec: Any) -> tuple[str, Any, float | None]:
-        """The guard's fallback ``dec``, or a better one by the guard's own ranking (moving part
-        predicted free first, then the largest predicted clearance over its horizon): the
-        proposed ``motion``, or driving ``v_max x 1.5 s`` in one of 8 directions (obstacles that
-        ignore the robot are escaped by moving, not only by stopping)."""
-        guard, spec = self.guard, self.spec
-        cfg = guard.config
-        h = t + cfg.horizon_s
-        best = (bool(dec.safe), -math.inf if dec.predicted_clearance_m is None
-                else float(dec.predicted_clearance_m))
-        out: tuple[str, Any, float | None] = (dec.kind, dec.trajectory, dec.predicted_clearance_m)
-        cands: list[tuple[str, Any]] = [] if motion is None else [("motion", motion)]
+        """The best fallback among the guard's (hold or brake, turn away, back off; ``dec`` is
+        its own choice), the proposed ``motion`` and driving ``v_max x 1.5 s`` in one of 8
+        directions, along a straight line from rest and, when the robot moves, along a smooth
+        curve from its speed and heading (obstacles that ignore the robot are escaped by
+        moving, not only by stopping).
+
+        Ranked, best first, by :meth:`_fallback_rank`: free over the guard's horizon against
+        the full discs; then free over it against the discs planned against (capped growth,
+        ``plan_extra_m``); then its moving part free against the full discs (any contact would
+        find the robot at rest: the guard's own criterion); then the latest first contact
+        against the planned discs; then the largest clearance against the full discs. A hold
+        that the planned discs run into is thus no longer preferred to a motion they leave
+        free: standing still where an obstacle is predicted to pass is a collision too.
+        """
+        spec = self.spec
+        cands: list[tuple[str, Any]] = [(kind, tr) for kind, tr, _ in
+                                        self.guard.candidates(t, state, safe)]
+        if motion is not None:
+            cands.append(("motion", motion))
         p0 = np.array([state.x, state.y])
-        radius = spec.radius + cfg.margin
+        radius = spec.radius + self.guard.config.margin
         dist = 1.5 * spec.v_max
         for k in range(8):
             a = state.theta + k * math.pi / 4.0
@@ -356,14 +364,37 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             tr = polyline_trajectory(np.array([p0, target]), spec, state, t, self.obstacles, radius)
             if tr.certified_free:
                 cands.append(("evade", tr))
+            if abs(state.v) > 1e-3:
+                # and a smooth curve there from the current speed and heading (no braking first)
+                tr = plan_motion(np.array([p0, target]), spec, state, self.obstacles, t,
+                                 allow_turn=False)
+                if tr.certified_free and tr.feasible:
+                    cands.append(("evade", tr))
+        planned = self._capped(safe)
+        best: tuple[Any, ...] | None = None
+        out: tuple[str, Any, float | None] = (dec.kind, dec.trajectory, dec.predicted_clearance_m)
         for kind, tr in cands:
-            t_end = max(float(tr.t_end), t)
-            free = first_collision(tr, safe, spec.radius, t_from=t, t_until=t_end,
-                                   margin=cfg.margin, sample_dt=cfg.sample_dt) is None
-            clear = guard.clearance(tr, safe, t, max(h, t_end))
-            if (free, clear) > best:
-                best, out = (free, clear), (kind, tr, clear)
+            rank, clear = self._fallback_rank(tr, t, safe, planned)
+            if best is None or rank > best:
+                best, out = rank, (kind, tr, clear)
         return out
+
+    def _fallback_rank(self, tr: Any, t: float, full: list[PredictedObstacle],
+                       planned: list[PredictedObstacle]) -> tuple[tuple[Any, ...], float]:
+        """The ranking key of fallback ``tr`` from ``t`` [s] (larger is better, see
+        :meth:`_evasions`) and its clearance [m] against the full discs over the horizon."""
+        guard = self.guard
+        cfg = guard.config
+        t_end = max(float(tr.t_end), t)
+        h = max(t + cfg.horizon_s, t_end)
+        r = self.spec.radius
+        clear = guard.clearance(tr, full, t, h)
+        hit = first_collision(tr, planned, r, t_from=t, t_until=h, margin=cfg.margin,
+                              sample_dt=cfg.sample_dt)
+        moving_free = first_collision(tr, full, r, t_from=t, t_until=t_end, margin=cfg.margin,
+                                      sample_dt=cfg.sample_dt) is None
+        return (clear >= cfg.margin, hit is None, moving_free,
+                math.inf if hit is None else float(hit.t), clear), clear
 
     def _fallback(self, obs: Observation, t_switch: float, preds: list[PredictedObstacle],
                   reason: str) -> Trajectory:
