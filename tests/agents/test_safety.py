@@ -200,3 +200,22 @@ def test_gap_walker_no_robot_caused_collision_in_6_seeds(waiting):
         res = simulate(sc, agent, seed=seed)
         assert not (res.collision and res.collision_robot_caused), (seed, res.status)
         check_invariant(sc, agent, res)
+
+
+def test_a_motion_the_robot_cannot_take_up_is_not_started():
+    # plan_motion's best effort for a robot at 2 m/s before a wall starts at about 1 m/s
+    # (feasible=False): free of every prediction, but not where the robot would go. The guard
+    # falls back instead, to a motion that starts at the robot's speed.
+    from anyplan.world.scenario import scenario_from_dict
+    from tests.conftest import fast_at_a_wall_dict
+
+    sc = scenario_from_dict(fast_at_a_wall_dict())
+    obst = sc.obstacle_set()
+    state = RobotState(1.0, 1.0, 0.0, 2.0, 0.0)
+    motion = plan_motion(np.array([[1.0, 1.0], [1.4, 1.0], [1.4, 7.0]]), sc.robot, state, obst,
+                         0.0, margin=0.015, grid_step=0.05)
+    assert not motion.feasible and motion.state(0.0).v < 1.5
+    guard = SafetyGuard(sc.robot, obst)
+    d = guard.decide(0.0, motion, None, state, [_parked_disc("far", 6.0, 7.0)], 0.3)
+    assert d.kind in FALLBACK_KINDS and "infeasible" in d.reason
+    assert d.trajectory.state(0.0).v == pytest.approx(2.0)

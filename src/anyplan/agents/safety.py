@@ -206,7 +206,11 @@ class SafetyGuard:
             commit_s: Time [s] before the agent can act again.
         """
         reason = "no motion proposed"
-        if motion is not None:
+        if motion is not None and not getattr(motion, "feasible", True):
+            # The robot cannot take it up from its state (plan_motion's best effort): what is
+            # predicted along it is not where the robot goes.
+            reason = "proposed motion: infeasible from the robot's state"
+        elif motion is not None:
             rule, tc, tr, fc = self.check(motion, preds, t, commit_s)
             if rule != "unsafe":
                 return self._log(Decision(t, "motion", motion, True, rule, tc, tr, fc))
