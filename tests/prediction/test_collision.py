@@ -241,3 +241,75 @@ def test_track_box_broad_phase_changes_no_answer(seed, monkeypatch):
                                              m.positions(grid), m.max_speed, 0.35)
             assert np.isfinite(bounds).any()
     assert skipped > 0  # the broad phase did skip some
+
+
+def _start_bounds_per_length(obstacles, far, grid, gc, pc, vr, reach0):
+    """The former _start_bounds: one interpolation per group of tracks of one keyframe count."""
+    import math
+
+    from anyplan.prediction import collision
+    from anyplan.world.motion import WaypointMotion
+
+    n = len(obstacles)
+    out = np.full(n, -math.inf)
+    out[far] = math.inf
+    if len(gc) < 2:
+        return out
+    dt = np.diff(gc)
+    half_fine = 0.5 * float(np.diff(grid).max())
+    groups: dict[int, list[int]] = {}
+    for k, o in enumerate(obstacles):
+        if not far[k] and o.growth is None and isinstance(o.motion, WaypointMotion):
+            groups.setdefault(len(o.motion.keyframes), []).append(k)
+    for ks in groups.values():
+        kf = np.stack([obstacles[k].motion.keyframes for k in ks])
+        tm = np.mod(gc[None, :], kf[:, -1, 0][:, None])
+        i = np.clip((kf[:, None, :, 0] <= tm[:, :, None]).sum(axis=2) - 1, 0, kf.shape[1] - 2)
+        a = np.take_along_axis(kf, i[:, :, None].repeat(3, axis=2), axis=1)
+        b = np.take_along_axis(kf, (i + 1)[:, :, None].repeat(3, axis=2), axis=1)
+        w = np.clip((tm - a[:, :, 0]) / (b[:, :, 0] - a[:, :, 0]), 0.0, 1.0)
+        d = np.hypot(pc[None, :, 0] - (a[:, :, 1] + w * (b[:, :, 1] - a[:, :, 1])),
+                     pc[None, :, 1] - (a[:, :, 2] + w * (b[:, :, 2] - a[:, :, 2])))
+        lip = np.array([vr + collision._track(obstacles[k])[1] for k in ks])
+        need = (reach0 + np.array([obstacles[k].radius for k in ks]) + lip * half_fine
+                + 1e-9 * (1.0 + reach0 + lip))
+        low = 0.5 * (d[:, :-1] + d[:, 1:] - lip[:, None] * dt[None, :]) <= need[:, None]
+        first = np.argmax(low, axis=1)
+        out[np.array(ks)] = np.where(low.any(axis=1), gc[first], math.inf)
+    return out
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_start_bounds_of_tracks_of_every_length_at_once_are_the_per_length_ones(seed):
+    """Tracks of 2-9 keyframes interpolated in one padded stack: bit for bit the bounds of one
+    interpolation per keyframe count, with far, growing and other obstacles mixed in; the
+    padded stack cached for the same tracks is rebuilt for other ones."""
+    from anyplan.prediction import collision
+    from anyplan.prediction.base import RadiusGrowth
+    from anyplan.world.motion import WaypointMotion
+
+    rng = np.random.default_rng(seed)
+    obs = []
+    for i in range(30):
+        if i % 7 == 3:
+            m = UnicycleMotion(*rng.uniform((0, 0, -np.pi, 0.0, 0.0), (15, 11, np.pi, 0.8, 0.3)))
+        else:
+            nk = int(rng.integers(2, 10))
+            t = np.cumsum(np.r_[0.0, rng.uniform(0.5, 4.0, nk - 1)])
+            m = WaypointMotion(np.column_stack([t, rng.uniform((0, 0), (15, 11), (nk, 2))]))
+        g = RadiusGrowth(0.0, np.array([0.0, 5.0]), np.array([0.0, 0.5])) if i % 9 == 4 else None
+        obs.append(PredictedObstacle(f"o{i}", float(rng.uniform(0.2, 0.5)), m, g))
+    for mid in MOTIONS:
+        m = MOTIONS[mid]
+        grid = np.linspace(m.t_start, m.t_end + 40.0, 401)
+        gc = grid[::16]
+        pc = m.positions(gc)
+        far = rng.random(len(obs)) < 0.2
+        for sub in (obs, obs[::2], obs[5:]):  # other sets of tracks: the cache must miss
+            fa = far[: len(sub)]
+            got = collision._start_bounds(sub, fa, grid, gc, pc, m.max_speed, 0.35)
+            want = _start_bounds_per_length(sub, fa, grid, gc, pc, m.max_speed, 0.35)
+            assert np.array_equal(got, want)
+            assert np.isfinite(got).any() and (got == -np.inf).any()
+            assert np.array_equal(collision._start_bounds(sub, fa, grid, gc, pc, m.max_speed, 0.35),
+                                  want)  # from the cache

@@ -296,40 +296,65 @@ def _far_from_tracks(obstacles: Sequence[PredictedObstacle], gc: np.ndarray, pc:
         return lb > need + 0.5 * lip * float(dt.max()) + 1e-9 * (1.0 + need + lip)
 
 
+#: The keyframes of recent sets of pacing tracks, padded to one length (``_padded``): key the
+#: motions' ids, value (the motions, kept alive so that an id is not reused, the stack).
+_PADDED: dict[tuple[int, ...], tuple[tuple[object, ...], np.ndarray, np.ndarray]] = {}
+
+
+def _padded(motions: Sequence[WaypointMotion]) -> tuple[np.ndarray, np.ndarray]:
+    """The keyframes of ``motions`` stacked (n, K, 3) with K the longest, the rows past a
+    track's own end at time +inf (never <= a time), and each track's keyframe count (n,)."""
+    key = tuple(id(m) for m in motions)
+    hit = _PADDED.get(key)
+    if hit is not None and all(a is b for a, b in zip(hit[0], motions, strict=True)):
+        return hit[1], hit[2]
+    lens = np.array([len(m.keyframes) for m in motions], dtype=np.int64)
+    kf = np.zeros((len(motions), int(lens.max()), 3))
+    kf[:, :, 0] = math.inf
+    for j, m in enumerate(motions):
+        kf[j, :lens[j]] = m.keyframes
+    if len(_PADDED) >= 64:
+        _PADDED.clear()
+    _PADDED[key] = (tuple(motions), kf, lens)
+    return kf, lens
+
+
 def _start_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, grid: np.ndarray,
                   gc: np.ndarray, pc: np.ndarray, vr: float, reach0: float) -> np.ndarray:
     """A lower bound of each obstacle's first uncertified grid time in :func:`_predict_uncached`
     (inf: it has none), for the pacing (waypoints) discs of fixed size from one interpolation of
     all their tracks at the coarse times, -inf for the others. Before the first coarse interval
     whose bound is <= reach + L dt_max / 2 (+ 1e-9 m, far above the interpolations' rounding),
-    the gap exceeds reach + L dt_max / 2, so no fine interval there is uncertified."""
+    the gap exceeds reach + L dt_max / 2, so no fine interval there is uncertified. The tracks
+    of every length are interpolated at once (keyframes padded, ``_padded``): per track the same
+    operations, element by element, as one track alone."""
     n = len(obstacles)
     out = np.full(n, -math.inf)
     out[far] = math.inf
     if len(gc) < 2:
         return out
+    ks = [k for k, o in enumerate(obstacles)
+          if not far[k] and o.growth is None and isinstance(o.motion, WaypointMotion)]
+    if not ks:
+        return out
     dt = np.diff(gc)
     half_fine = 0.5 * float(np.diff(grid).max())
-    groups: dict[int, list[int]] = {}
-    for k, o in enumerate(obstacles):
-        if not far[k] and o.growth is None and isinstance(o.motion, WaypointMotion):
-            groups.setdefault(len(o.motion.keyframes), []).append(k)
-    for ks in groups.values():
-        kf = np.stack([obstacles[k].motion.keyframes for k in ks])  # type: ignore[attr-defined]
-        tm = np.mod(gc[None, :], kf[:, -1, 0][:, None])  # (obstacles, coarse times)
-        i = np.clip((kf[:, None, :, 0] <= tm[:, :, None]).sum(axis=2) - 1, 0, kf.shape[1] - 2)
-        a = np.take_along_axis(kf, i[:, :, None].repeat(3, axis=2), axis=1)
-        b = np.take_along_axis(kf, (i + 1)[:, :, None].repeat(3, axis=2), axis=1)
-        w = np.clip((tm - a[:, :, 0]) / (b[:, :, 0] - a[:, :, 0]), 0.0, 1.0)
-        d = np.hypot(pc[None, :, 0] - (a[:, :, 1] + w * (b[:, :, 1] - a[:, :, 1])),
-                     pc[None, :, 1] - (a[:, :, 2] + w * (b[:, :, 2] - a[:, :, 2])))
-        sel = np.array(ks)
-        lip = np.array([vr + _track(obstacles[k])[1] for k in ks])
-        need = (reach0 + np.array([obstacles[k].radius for k in ks]) + lip * half_fine
-                + 1e-9 * (1.0 + reach0 + lip))
-        low = 0.5 * (d[:, :-1] + d[:, 1:] - lip[:, None] * dt[None, :]) <= need[:, None]
-        first = np.argmax(low, axis=1)
-        out[sel] = np.where(low.any(axis=1), gc[first], math.inf)
+    kf, lens = _padded([obstacles[k].motion for k in ks])  # type: ignore[misc]
+    period = kf[np.arange(len(ks)), lens - 1, 0]
+    tm = np.mod(gc[None, :], period[:, None])  # (obstacles, coarse times)
+    i = np.clip((kf[:, None, :, 0] <= tm[:, :, None]).sum(axis=2) - 1, 0, (lens - 2)[:, None])
+    rows = np.arange(len(ks))[:, None]
+    a, b = kf[rows, i], kf[rows, i + 1]  # (obstacles, coarse times, 3)
+    w = np.clip((tm - a[:, :, 0]) / (b[:, :, 0] - a[:, :, 0]), 0.0, 1.0)
+    d = np.hypot(pc[None, :, 0] - (a[:, :, 1] + w * (b[:, :, 1] - a[:, :, 1])),
+                 pc[None, :, 1] - (a[:, :, 2] + w * (b[:, :, 2] - a[:, :, 2])))
+    sel = np.array(ks)
+    lip = np.array([vr + _track(obstacles[k])[1] for k in ks])
+    need = (reach0 + np.array([obstacles[k].radius for k in ks]) + lip * half_fine
+            + 1e-9 * (1.0 + reach0 + lip))
+    low = 0.5 * (d[:, :-1] + d[:, 1:] - lip[:, None] * dt[None, :]) <= need[:, None]
+    first = np.argmax(low, axis=1)
+    out[sel] = np.where(low.any(axis=1), gc[first], math.inf)
     return out
 
 
