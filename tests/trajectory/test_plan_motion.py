@@ -185,8 +185,10 @@ def test_smooth_start_matches_the_current_turn_rate(w0, target, limits_checker):
     assert 0.4 - 0.01 <= v[0] <= 0.4 + 1e-12
     assert w[0] == pytest.approx(w0 * v[0] / 0.4, abs=1e-9)
     limits_checker(tr, spec)
-    # it beats stopping and turning toward the path
-    assert tr.duration < tr.info["candidates"]["turn+smooth"]
+    # it beats stopping and turning toward the path: its duration, or a lower bound of it when
+    # it was not built for that reason (``pruned``)
+    turn = {**tr.info.get("pruned", {}), **tr.info["candidates"]}["turn+smooth"]
+    assert tr.duration < turn
 
 
 def test_curvature_matched_curve_keeps_points_and_conditions():
@@ -228,3 +230,42 @@ def test_margin_is_reduced_to_the_start_clearance():
     tr = plan_motion(np.array([[1.0, 0.305], [9.0, 0.305]]), spec, st, obs, 0.0, margin=0.02)
     assert tr.certified_free and tr.kind == "smooth"
     assert dense_clearance(tr, obs) >= spec.radius - 1e-9
+
+
+def test_turn_candidate_pruned_by_its_bound_changes_no_motion(monkeypatch):
+    """The turn-in-place candidate is not built when its lower bound (turn, then a straight line
+    of the curve's chord under v_max and a_max) is later than the smooth start: on random paths
+    and states (at rest and moving, aligned or not) the same motion, bit for bit, as building
+    it always; it is pruned in some cases and wins in others; and where it is built its
+    duration is never below the bound."""
+    from anyplan.trajectory import motion as motion_mod
+    from anyplan.trajectory.profile import time_lower_bound
+
+    rng = np.random.default_rng(7)
+    obs = ObstacleSet([Circle((5.0, 3.0), 0.7), Circle((3.0, 1.5), 0.4)], bounds=(0.0, 0.0, 10.0, 6.0))
+    spec = load_scenario("paper-1").robot
+    pruned = won = 0
+    for _ in range(40):
+        p0 = rng.uniform((0.5, 0.5), (2.0, 5.5))
+        mid = rng.uniform((2.0, 0.5), (8.0, 5.5), (int(rng.integers(0, 3)), 2))
+        path = np.vstack([p0, mid, rng.uniform((8.0, 0.5), (9.5, 5.5))])
+        if not obs.path_free(path, spec.radius):
+            continue
+        v = float(rng.choice([0.0, 0.3, 1.0]))
+        st = RobotState(*p0, float(rng.uniform(-np.pi, np.pi)), v, float(rng.choice([0.0, 0.1])) * (v > 0))
+        got = plan_motion(path, spec, st, obs, 3.0)
+        with monkeypatch.context() as mp:
+            mp.setattr(motion_mod, "_PRUNE_SLACK_S", math.inf)  # never pruned
+            want = plan_motion(path, spec, st, obs, 3.0)
+        assert got.kind == want.kind and got.t_end == want.t_end
+        t = np.linspace(got.t_start, got.t_end, 301)
+        assert np.array_equal(np.column_stack(got.sample(t)), np.column_stack(want.sample(t)))
+        pruned += "pruned" in got.info
+        won += want.kind.endswith("turn+smooth")
+        if "turn+smooth" in want.info["candidates"] and want.kind.endswith("turn+smooth"):
+            curve_seg = want.segments[-1]
+            chord = float(np.hypot(*(want.polyline[-1] - want.polyline[0])))
+            assert want.t_end >= curve_seg.t0 + time_lower_bound(chord, spec, 0.0) - 1e-9
+        if "pruned" in got.info:
+            assert got.info["pruned"]["turn+smooth"] > got.duration
+    assert pruned > 0 and won > 0

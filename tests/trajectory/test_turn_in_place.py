@@ -70,7 +70,8 @@ def test_no_turn_when_nearly_aligned(limits_checker):
     tr = plan_motion(path, SPEC, RobotState(1.0, 2.0, 0.1), obs, 0.0)
     assert tr.kind == "smooth"
     c = tr.info["candidates"]
-    assert c["smooth"] <= c["turn+smooth"]
+    # the turn's duration, or a lower bound of it when it was not built for that reason
+    assert c["smooth"] <= {**tr.info.get("pruned", {}), **c}["turn+smooth"]
     limits_checker(tr, SPEC)
 
 

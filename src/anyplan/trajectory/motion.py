@@ -40,6 +40,9 @@ _EPS_V = 1e-6  # [m/s] speeds below this count as rest
 _EPS_TH = 1e-3  # [rad] headings closer than this count as aligned
 _V_CURVATURE = 0.02  # [m/s] above this speed the start curvature omega0 / v0 is matched
 _MAX_START_CURVATURE = 5.0  # [1/m] tighter start curvatures are not matched
+#: [s] B (turn in place, then a curve) is not built when its lower bound exceeds A's arrival by
+#: more than this: far above the rounding of a profile's time (~1e-12 s), far below a control step.
+_PRUNE_SLACK_S = 1e-6
 
 
 def turn_segment(x: float, y: float, theta: float, target: float, spec: RobotSpec, t0: float,
@@ -163,7 +166,8 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
             times the control period).
 
     Returns:
-        The fastest admissible :class:`Trajectory`; ``info`` lists the candidate durations.
+        The fastest admissible :class:`Trajectory`; ``info`` lists the candidate durations
+        (``pruned``: the lower bounds of those not built because they could not win).
         If nothing is both feasible from the current state and certified collision-free (a path
         that itself collides, or a robot too fast for the start of every curve), the best effort
         is returned with ``feasible`` or ``certified_free`` False.
@@ -234,9 +238,19 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         if turn.t1 > turn.t0:
             segs.append(turn)
             t = turn.t1
-        res_b = smooth_path(pts_b, obstacles, radius, start_heading=target,
-                            max_rounds=max_repair_rounds, grid_step=grid_step)
-        if res_b.curve is not None and brake_free:
+        # No curve from rest is faster than a straight line of its ends' distance under v_max
+        # and a_max (the profile keeps both everywhere), so B cannot arrive before
+        # t + time_lower_bound(chord). When that is later than a certified, feasible A (by more
+        # than the profile's rounding, _PRUNE_SLACK_S), B would lose the choice below (the
+        # earlier motion, A on a tie): it is not smoothed.
+        bound = t + time_lower_bound(math.hypot(*(pts_b[-1] - pts_b[0])), spec, 0.0)
+        a_wins = bool(cands) and cands[0][0] and cands[0][2].certified_free and \
+            bound > cands[0][2].t_end + _PRUNE_SLACK_S
+        if a_wins:
+            info["pruned"] = {"turn+smooth": bound - t_start}
+        res_b = None if a_wins else smooth_path(pts_b, obstacles, radius, start_heading=target,
+                                                max_rounds=max_repair_rounds, grid_step=grid_step)
+        if res_b is not None and res_b.curve is not None and brake_free:
             prof = time_parameterize(res_b.curve, spec, 0.0)
             segs.append(CurveSegment(res_b.curve, prof, t))
             tr = Trajectory(segs, kind=(MotionKind.BRAKE_TURN_SMOOTH if braked
