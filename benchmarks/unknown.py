@@ -54,7 +54,7 @@ def _run(task: tuple[str, dict[str, Any], str, str, int, dict[str, Any]]) -> dic
     try:
         res = simulate(sc, make_agent(planner, **config), seed=seed)
     except Exception as exc:  # noqa: BLE001 - a planner failure is a result, reported
-        return {"suite": suite, "mode": mode, "planner": planner, "scenario": sc.name,
+        return {"suite": suite, "mode": mode, "planner": planner, "scenario": sc.name, "seed": seed,
                 "status": f"error: {type(exc).__name__}", "times": []}
     appeared = None
     if res.status == "collision" and res.collision_with is not None:
@@ -63,7 +63,7 @@ def _run(task: tuple[str, dict[str, Any], str, str, int, dict[str, Any]]) -> dic
         span = getattr(getattr(o, "motion", None), "span", None)
         appeared = bool(span is not None and res.collision_time_s is not None
                         and res.collision_time_s - span[0] <= 0.1)
-    return {"suite": suite, "mode": mode, "planner": planner, "scenario": sc.name,
+    return {"suite": suite, "mode": mode, "planner": planner, "scenario": sc.name, "seed": seed,
             "status": res.status, "robot_caused": bool(res.collision_robot_caused),
             "collision_with": res.collision_with, "collision_time_s": res.collision_time_s,
             "appeared_in_contact": appeared,

@@ -335,3 +335,29 @@ def test_evasion_from_a_moving_robot_keeps_its_speed():
     assert kind == "evade"
     assert tr.state(0.2).v > 0.75  # it did not brake first
     assert first_collision(tr, down, r, t_from=0.0, t_until=5.0, margin=m) is None
+
+
+def test_fallback_never_brakes_into_a_wall_when_a_curve_clears_it():
+    # A robot at 0.8 m/s heading 30 degrees down at a wall 0.2 m beyond its disc: braking
+    # straight ahead (0.64 m at 0.5 m/s^2) strikes the wall, so the guard's brake is not
+    # certified free; the fallback chosen clears the static obstacles (a curve from the robot's
+    # speed and heading).
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.world import RobotState, UnicycleMotion
+
+    data = _crossing_scenario().to_dict()
+    data["robot"].update({"v_max": 1.0, "omega_max": 2.0, "a_max": 0.5, "alpha_max": 4.0})
+    data["dynamic_obstacles"] = []
+    agent = make_agent("st-bitstar")
+    agent.reset(scenario_from_dict(data), np.random.default_rng(0))
+    state = RobotState(6.0, 0.5, -math.pi / 6, 0.8, 0.0)
+    far = [PredictedObstacle("far", 0.25, UnicycleMotion(1.0, 5.0, 0.0, 0.2), until=5.0)]
+    brake = agent.guard.candidates(0.0, state, far)[0]
+    assert brake[0] == "brake" and not brake[1].certified_free
+    dec = agent.guard.fallback(0.0, state, far, "test")
+    kind, tr, _ = agent._evasions(0.0, state, far, None, dec)
+    assert tr.certified_free and kind != "brake"
+    ts = np.linspace(0.0, float(tr.t_end), 200)
+    p = tr.positions(ts)
+    clear = np.array([agent.obstacles.clearance(tuple(q)) for q in p]) - agent.spec.radius
+    assert clear.min() >= 0.0

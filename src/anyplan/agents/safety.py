@@ -282,10 +282,12 @@ class SafetyGuard:
         static clearance."""
         spec, cfg = self.spec, self.config
         h = t + cfg.horizon_s
-        segs, t_rest, rest, _ = come_to_rest(state, spec, self.obstacles, spec.radius, t)
+        segs, t_rest, rest, free = come_to_rest(state, spec, self.obstacles, spec.radius, t)
         moving = abs(state.v) > _EPS_V
+        # certified_free: whether braking straight ahead clears the static obstacles (at speed
+        # beside a wall, it may not: the motion in use would have curved away)
         hold = Trajectory(segs + [HoldSegment(rest.x, rest.y, rest.theta, t_rest, max(h, t_rest))],
-                          kind="brake" if moving else "hold")
+                          kind="brake" if moving else "hold", certified_free=bool(free))
         out: list[tuple[str, Trajectory, float]] = [("brake" if moving else "hold", hold, t_rest)]
         if not preds:
             return out
@@ -326,11 +328,13 @@ class SafetyGuard:
         for i, (kind, tr, t_rest) in enumerate(self.candidates(t, state, preds)):
             moving_free = self._hit(tr, preds, t, t_rest, self.config.margin) is None
             clear = self.clearance(tr, preds, t, max(h, t_rest))
-            scored.append((moving_free, clear, -FALLBACK_KINDS.index(kind), -i, kind, tr, t_rest))
-        best = max(scored, key=lambda s: s[:4])
-        cands = [(s[4], bool(s[0]), float(s[1])) for s in scored]
-        return Decision(t, best[4], best[5], bool(best[0]), "fallback", None, best[6], None,
-                        float(best[1]), cands, reason)
+            scored.append((bool(tr.certified_free), moving_free, clear, -FALLBACK_KINDS.index(kind),
+                           -i, kind, tr, t_rest))
+        # a fallback that runs into a static obstacle ranks last: that collision is certain
+        best = max(scored, key=lambda s: s[:5])
+        cands = [(s[5], bool(s[1]), float(s[2])) for s in scored]
+        return Decision(t, best[5], best[6], bool(best[1]), "fallback", None, best[7], None,
+                        float(best[2]), cands, reason)
 
 
 def _max_radius(o: Any) -> float:

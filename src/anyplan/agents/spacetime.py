@@ -326,22 +326,26 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit)
         if dec.kind in ("motion", "keep"):
             return dec.kind, dec.trajectory
-        kind, tr, clear = self._evasions(t_switch, state, safe, motion, dec)
+        kind, tr, clear = self._evasions(t_switch, state, safe, motion, dec, self.trajectory)
         self.record.fallbacks.append(
             {"t": float(obs.t), "kind": kind, "reason": dec.reason or reason,
              "predicted_clearance_m": _finite(clear)})
         return kind, tr
 
     def _evasions(self, t: float, state: RobotState, safe: list[PredictedObstacle],
-                  motion: Trajectory | None, dec: Any) -> tuple[str, Any, float | None]:
+                  motion: Trajectory | None, dec: Any, current: Trajectory | None = None
+                  ) -> tuple[str, Any, float | None]:
         """The best fallback among the guard's (hold or brake, turn away, back off; ``dec`` is
-        its own choice), the proposed ``motion`` and driving ``v_max x 1.5 s`` in one of 8
+        its own choice), the proposed ``motion``, driving ``v_max x 1.5 s`` in one of 8
         directions, along a straight line from rest and, when the robot moves, along a smooth
         curve from its speed and heading (obstacles that ignore the robot are escaped by
-        moving, not only by stopping).
+        moving, not only by stopping), and, last (only when strictly better), keeping the
+        motion in use (``current``: e.g. the curve that clears a wall when braking straight
+        would not).
 
-        Ranked, best first, by :meth:`_fallback_rank`: free over the guard's horizon against
-        the full discs; then free over it against the discs planned against (capped growth,
+        Ranked, best first, by :meth:`_fallback_rank`: clear of the static obstacles (braking
+        straight ahead beside a wall may not be); free over the guard's horizon against the
+        full discs; then free over it against the discs planned against (capped growth,
         ``plan_extra_m``); then its moving part free against the full discs (any contact would
         find the robot at rest: the guard's own criterion); then the latest first contact
         against the planned discs; then the largest clearance against the full discs. A hold
@@ -370,6 +374,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                                  allow_turn=False)
                 if tr.certified_free and tr.feasible:
                     cands.append(("evade", tr))
+        if current is not None and t < float(current.t_end) - 1e-9:
+            cands.append(("keep", current))
         planned = self._capped(safe)
         best: tuple[Any, ...] | None = None
         out: tuple[str, Any, float | None] = (dec.kind, dec.trajectory, dec.predicted_clearance_m)
@@ -393,8 +399,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                               sample_dt=cfg.sample_dt)
         moving_free = first_collision(tr, full, r, t_from=t, t_until=t_end, margin=cfg.margin,
                                       sample_dt=cfg.sample_dt) is None
-        return (clear >= cfg.margin, hit is None, moving_free,
-                math.inf if hit is None else float(hit.t), clear), clear
+        return (bool(getattr(tr, "certified_free", True)), clear >= cfg.margin, hit is None,
+                moving_free, math.inf if hit is None else float(hit.t), clear), clear
 
     def _fallback(self, obs: Observation, t_switch: float, preds: list[PredictedObstacle],
                   reason: str) -> Trajectory:
