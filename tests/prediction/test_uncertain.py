@@ -3,6 +3,7 @@ of the uncertainty radius on recorded pedestrians."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -106,3 +107,32 @@ def test_uncertainty_radius_covers_recorded_pedestrians_at_the_stated_rate(scene
     assert cov[:5].mean() >= 0.90 and r.coverage >= 0.80
     # the tracker is at least as accurate as the constant-velocity baseline on noisy positions
     assert r.ade_imm <= r.ade_cv and r.fde_imm <= r.fde_cv
+
+
+def test_manoeuvre_allowance_covers_an_obstacle_that_turns_within_it():
+    # An exact pose and twist (perception 'twist'); the obstacle really turns at a lateral
+    # acceleration v * omega = 1.2 m/s^2 <= the allowance 1.5 m/s^2: the grown disc around the
+    # straight extrapolation contains its true centre at every time until the cap (1 m).
+    from anyplan.prediction.base import ObstacleObservation, manoeuvre_growth
+
+    t0, v, w = 3.0, 1.5, 0.8
+    truth = UnicycleMotion(2.0, 1.0, 0.3, v, w, start_time=t0)
+    seen = ObstacleObservation("a", t0, 2.0, 1.0, 0.3, v, 0.0, 0.25)  # seen going straight
+    p = ConstantTwistPredictor(manoeuvre_accel=1.5, manoeuvre_cap_m=1.0).predict([seen])[0]
+    assert p.growth is not None and p.growth.max_extra == pytest.approx(1.0)
+    ts = np.linspace(t0, t0 + 4.0, 401)
+    gap = np.hypot(*(truth.positions(ts) - p.positions(ts)).T)
+    extra = p.growth.at(ts)
+    inside = gap <= extra + 1e-12
+    t_cap = t0 + math.sqrt(2.0 * 1.0 / 1.5)
+    assert inside[ts <= t_cap].all()
+    assert not inside.all()  # beyond the cap it may leave: the cap is a real limit
+    # without the allowance: no growth; an announced motion is never grown; nor a tracked disc
+    assert ConstantTwistPredictor().predict([seen])[0].growth is None
+    announced = ObstacleObservation("b", t0, 2.0, 1.0, 0.3, v, 0.0, 0.25, truth)
+    assert ConstantTwistPredictor(manoeuvre_accel=1.5).predict([announced])[0].growth is None
+    g = manoeuvre_growth(t0, 1.0, 0.5)
+    tracked = ObstacleObservation("c", t0, 2.0, 1.0, 0.3, v, 0.0, 0.25, None, g)
+    assert ConstantTwistPredictor(manoeuvre_accel=1.5).predict([tracked])[0].growth is g
+    with pytest.raises(ValueError, match="manoeuvre_accel"):
+        ConstantTwistPredictor(manoeuvre_accel=-1.0)

@@ -124,6 +124,11 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             exact twists (``twist``) are planned against in full; ``"horizon"``: both apply to
             every prediction without an announced motion; ``"never"``: the horizon without the
             guard.
+        manoeuvre_accel: A manoeuvre allowance [m/s^2] for exact twists (``twist``
+            perception): their discs grow by ``manoeuvre_accel tau^2 / 2`` up to 1 m
+            (:func:`~anyplan.prediction.base.manoeuvre_growth`), so they are uncertain and the
+            receding horizon and the guard apply to them as to tracked ones. 0: exact twists
+            are planned against in full (the default; docs/perception.md has the figures).
         **kwargs: Further options of :class:`SequentialBITStarAgent` (planning_delay, ...).
     """
 
@@ -134,7 +139,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     def __init__(self, config: SequentialConfig | None = None, *, patience_s: float = 3.0,
                  max_wait_s: float = 30.0, lattice_dt_s: float = 0.25, accept_s: float = 0.5,
                  horizon_s: float | None = 3.0, plan_extra_m: float | None = 0.3,
-                 guard: str = "growth", **kwargs: Any) -> None:
+                 guard: str = "growth", manoeuvre_accel: float = 0.0,
+                 **kwargs: Any) -> None:
         loop = {k: kwargs.pop(k) for k in list(kwargs) if k in _LOOP_FIELDS}  # e.g. from --set
         if config is None:
             config = dataclasses.replace(_DEFAULT_LOOP, **loop)
@@ -151,6 +157,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         if guard not in ("growth", "horizon", "never"):
             raise ValueError(f"guard: 'growth', 'horizon' or 'never', got {guard!r}")
         self.guard_mode = guard
+        if not (isinstance(manoeuvre_accel, int | float) and manoeuvre_accel >= 0.0):
+            raise ValueError(f"manoeuvre_accel: must be >= 0, got {manoeuvre_accel!r}")
+        self.manoeuvre_accel = float(manoeuvre_accel)
         if plan_extra_m is not None and not (isinstance(plan_extra_m, int | float)
                                              and plan_extra_m >= 0.0):
             raise ValueError(f"plan_extra_m: must be >= 0 or null, got {plan_extra_m!r}")
@@ -165,7 +174,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
         warm_up_spacetime()
         super().reset(scenario, rng)
-        self.predictor = ConstantTwistPredictor(horizon_s=self.horizon_s)
+        self.predictor = ConstantTwistPredictor(horizon_s=self.horizon_s,
+                                                manoeuvre_accel=self.manoeuvre_accel)
         self._cands: list[tuple[float, Trajectory, np.ndarray, list[Shape]]] = []
         self._tried: list[tuple[np.ndarray, list[Shape]]] = []
         self._path: np.ndarray | None = None

@@ -146,25 +146,56 @@ class ConstantTwistPredictor:
     (:attr:`PredictedObstacle.until`); announced motions are kept in full.
     """
 
-    def __init__(self, use_announced: bool = True, horizon_s: float | None = None) -> None:
+    def __init__(self, use_announced: bool = True, horizon_s: float | None = None,
+                 manoeuvre_accel: float = 0.0, manoeuvre_cap_m: float = 1.0) -> None:
         if horizon_s is not None and not horizon_s > 0.0:
             raise ValueError(f"horizon_s: must be > 0 or None, got {horizon_s!r}")
+        if not manoeuvre_accel >= 0.0:
+            raise ValueError(f"manoeuvre_accel: must be >= 0, got {manoeuvre_accel!r}")
+        if not manoeuvre_cap_m >= 0.0:
+            raise ValueError(f"manoeuvre_cap_m: must be >= 0, got {manoeuvre_cap_m!r}")
         self.use_announced = use_announced
         self.horizon_s = horizon_s
+        self.manoeuvre_accel = float(manoeuvre_accel)
+        self.manoeuvre_cap_m = float(manoeuvre_cap_m)
 
     def predict(self, observations: Sequence[ObstacleObservation]) -> list[PredictedObstacle]:
         """Predicted motions, with times measured on the same clock as the observations."""
         out = []
         for o in observations:
             until = math.inf
+            growth = o.growth
             if self.use_announced and o.motion is not None:
                 motion: Motion = o.motion
             else:
                 motion = _shifted_unicycle(o)
                 if self.horizon_s is not None:
                     until = o.t + self.horizon_s
-            out.append(PredictedObstacle(o.name, o.radius, motion, o.growth, until))
+                if growth is None and self.manoeuvre_accel > 0.0:
+                    growth = manoeuvre_growth(o.t, self.manoeuvre_accel, self.manoeuvre_cap_m)
+            out.append(PredictedObstacle(o.name, o.radius, motion, growth, until))
         return out
+
+
+#: Horizon knots [s] of :func:`manoeuvre_growth`.
+_MANOEUVRE_TAUS = np.array([0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0])
+
+
+def manoeuvre_growth(t0: float, accel: float, cap_m: float) -> RadiusGrowth:
+    """The extra radius of an exact pose and twist whose future is unknown: an obstacle that
+    may leave its constant twist with an acceleration of up to ``accel`` [m/s^2] is, after
+    tau [s], within ``accel tau^2 / 2`` of its extrapolated centre; capped at ``cap_m`` [m].
+
+    The knots interpolate the parabola linearly from above (it is convex), so the disc always
+    contains the bound.
+
+    Examples:
+        >>> g = manoeuvre_growth(10.0, 2.0, 1.0)
+        >>> float(g.at(10.0)), float(g.at(10.5)), float(g.at(11.0)), float(g.at(20.0))
+        (0.0, 0.25, 1.0, 1.0)
+    """
+    return RadiusGrowth(t0, _MANOEUVRE_TAUS,
+                        np.minimum(0.5 * accel * _MANOEUVRE_TAUS ** 2, cap_m))
 
 
 def _shifted_unicycle(o: ObstacleObservation) -> Motion:
