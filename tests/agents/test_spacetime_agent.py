@@ -281,6 +281,18 @@ def test_dynabarn_53_known_motion_no_robot_caused_collision():
     for (_, prev), (ts, tr) in zip(agent.executed[:-1], agent.executed[1:], strict=True):
         assert abs(tr.state(ts).v - prev.state(ts).v) <= 0.05
 
+
+def _agent_in_empty_room(**limits: float):
+    """st-bitstar, reset in the crossing scenario's 12 m x 6 m room without its obstacle, for a
+    robot with these limits (the fallback tests give it the predictions themselves)."""
+    data = _crossing_scenario().to_dict()
+    data["robot"].update(limits)
+    data["dynamic_obstacles"] = []
+    agent = make_agent("st-bitstar")
+    agent.reset(scenario_from_dict(data), np.random.default_rng(0))
+    return agent
+
+
 def test_fallback_leaves_a_predicted_collision_rather_than_hold_in_it():
     # A robot at rest, an uncertain obstacle heading at it (1 m/s, 3 m away): holding is struck
     # by the disc planned against (capped at plan_extra_m); driving 1.5 m sideways touches only
@@ -291,11 +303,7 @@ def test_fallback_leaves_a_predicted_collision_rather_than_hold_in_it():
     from anyplan.prediction.collision import first_collision
     from anyplan.world import RobotState, UnicycleMotion
 
-    data = _crossing_scenario().to_dict()
-    data["robot"].update({"v_max": 1.0, "omega_max": 1.0, "a_max": 1.0, "alpha_max": 2.0})
-    data["dynamic_obstacles"] = []
-    agent = make_agent("st-bitstar")
-    agent.reset(scenario_from_dict(data), np.random.default_rng(0))
+    agent = _agent_in_empty_room(v_max=1.0, omega_max=1.0, a_max=1.0, alpha_max=2.0)
     state = RobotState(4.0, 2.0, math.pi / 2, 0.0, 0.0)
     growth = RadiusGrowth(0.0, np.array([0.0, 1.0, 3.0]), np.array([0.0, 0.5, 1.5]))
     obst = [PredictedObstacle("F", 0.25, UnicycleMotion(7.0, 2.0, math.pi, 1.0), growth, until=3.0)]
@@ -321,11 +329,7 @@ def test_evasion_from_a_moving_robot_keeps_its_speed():
     from anyplan.prediction.collision import first_collision
     from anyplan.world import RobotState, UnicycleMotion
 
-    data = _crossing_scenario().to_dict()
-    data["robot"].update({"v_max": 1.0, "omega_max": 1.0, "a_max": 1.0, "alpha_max": 2.0})
-    data["dynamic_obstacles"] = []
-    agent = make_agent("st-bitstar")
-    agent.reset(scenario_from_dict(data), np.random.default_rng(0))
+    agent = _agent_in_empty_room(v_max=1.0, omega_max=1.0, a_max=1.0, alpha_max=2.0)
     state = RobotState(3.0, 3.0, 0.0, 1.0, 0.0)
     down = [PredictedObstacle("D", 0.25, UnicycleMotion(3.5, 4.6, -math.pi / 2, 1.0), until=5.0)]
     dec = agent.guard.fallback(0.0, state, down, "test")
@@ -345,11 +349,7 @@ def test_fallback_never_brakes_into_a_wall_when_a_curve_clears_it():
     from anyplan.prediction import PredictedObstacle
     from anyplan.world import RobotState, UnicycleMotion
 
-    data = _crossing_scenario().to_dict()
-    data["robot"].update({"v_max": 1.0, "omega_max": 2.0, "a_max": 0.5, "alpha_max": 4.0})
-    data["dynamic_obstacles"] = []
-    agent = make_agent("st-bitstar")
-    agent.reset(scenario_from_dict(data), np.random.default_rng(0))
+    agent = _agent_in_empty_room(v_max=1.0, omega_max=2.0, a_max=0.5, alpha_max=4.0)
     state = RobotState(6.0, 0.5, -math.pi / 6, 0.8, 0.0)
     far = [PredictedObstacle("far", 0.25, UnicycleMotion(1.0, 5.0, 0.0, 0.2), until=5.0)]
     brake = agent.guard.candidates(0.0, state, far)[0]
