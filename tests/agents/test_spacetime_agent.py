@@ -167,7 +167,7 @@ def test_evasion_beats_holding_before_a_fast_obstacle():
     state = RobotState(4.0, 3.0, math.pi / 2, 0.0, 0.0)
     fast = [PredictedObstacle("F", 0.6, UnicycleMotion(10.0, 3.0, math.pi, 1.5), until=5.0)]
     dec = agent.guard.fallback(0.0, state, fast, "test")
-    kind, tr, clear = agent._evasions(0.0, state, fast, None, dec)
+    kind, tr, clear = agent._evasions(0.0, state, fast, None)
     assert dec.predicted_clearance_m < 0.0  # the guard alone: struck
     assert kind == "evade" and clear > dec.predicted_clearance_m
     assert agent.guard.clearance(tr, fast, 0.0, 5.0) == pytest.approx(clear)
@@ -313,7 +313,7 @@ def test_fallback_leaves_a_predicted_collision_rather_than_hold_in_it():
     planned = agent._capped(obst)
     r = agent.spec.radius
     assert first_collision(dec.trajectory, planned, r, t_from=0.0, t_until=5.0) is not None
-    kind, tr, _ = agent._evasions(0.0, state, obst, None, dec)
+    kind, tr, _ = agent._evasions(0.0, state, obst, None)
     assert kind != "hold" and tr.t_end > 0.5
     # what it chose is free against the planned discs over the horizon ...
     assert first_collision(tr, planned, r, t_from=0.0, t_until=5.0,
@@ -335,7 +335,7 @@ def test_evasion_from_a_moving_robot_keeps_its_speed():
     down = [PredictedObstacle("D", 0.25, UnicycleMotion(3.5, 4.6, -math.pi / 2, 1.0), until=5.0)]
     dec = agent.guard.fallback(0.0, state, down, "test")
     assert not dec.safe  # whatever the guard picks (brake, turn away, back off) is struck moving
-    kind, tr, _ = agent._evasions(0.0, state, down, None, dec)
+    kind, tr, _ = agent._evasions(0.0, state, down, None)
     r, m = agent.spec.radius, agent.guard.config.margin
     assert kind == "evade"
     assert tr.state(0.2).v > 0.75  # it did not brake first
@@ -355,8 +355,7 @@ def test_fallback_never_brakes_into_a_wall_when_a_curve_clears_it():
     far = [PredictedObstacle("far", 0.25, UnicycleMotion(1.0, 5.0, 0.0, 0.2), until=5.0)]
     brake = agent.guard.candidates(0.0, state, far)[0]
     assert brake[0] == "brake" and not brake[1].certified_free
-    dec = agent.guard.fallback(0.0, state, far, "test")
-    kind, tr, _ = agent._evasions(0.0, state, far, None, dec)
+    kind, tr, _ = agent._evasions(0.0, state, far, None)
     assert tr.certified_free and kind != "brake"
     ts = np.linspace(0.0, float(tr.t_end), 200)
     p = tr.positions(ts)

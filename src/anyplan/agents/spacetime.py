@@ -346,17 +346,17 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit)
         if dec.kind in ("motion", "keep"):
             return dec.kind, dec.trajectory
-        kind, tr, clear = self._evasions(t_switch, state, safe, motion, dec, self.trajectory)
+        kind, tr, clear = self._evasions(t_switch, state, safe, motion, self.trajectory)
         self.record.fallbacks.append(
             {"t": float(obs.t), "kind": kind, "reason": dec.reason or reason,
              "predicted_clearance_m": _finite(clear)})
         return kind, tr
 
     def _evasions(self, t: float, state: RobotState, safe: list[PredictedObstacle],
-                  motion: Trajectory | None, dec: Any, current: Trajectory | None = None
-                  ) -> tuple[str, Any, float | None]:
-        """The best fallback among the guard's (hold or brake, turn away, back off; ``dec`` is
-        its own choice), the proposed ``motion``, driving ``v_max x 1.5 s`` in one of 8
+                  motion: Trajectory | None, current: Trajectory | None = None
+                  ) -> tuple[str, Any, float]:
+        """The best fallback, with its clearance [m], among the guard's (hold or brake, turn
+        away, back off), the proposed ``motion``, driving ``v_max x 1.5 s`` in one of 8
         directions, along a straight line from rest and, when the robot moves, along a smooth
         curve from its speed and heading (obstacles that ignore the robot are escaped by
         moving, not only by stopping), and, last (only when strictly better), keeping the
@@ -397,13 +397,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         if current is not None and t < float(current.t_end) - 1e-9:
             cands.append(("keep", current))
         planned = self._capped(safe)
-        best: tuple[Any, ...] | None = None
-        out: tuple[str, Any, float | None] = (dec.kind, dec.trajectory, dec.predicted_clearance_m)
-        for kind, tr in cands:
-            rank, clear = self._fallback_rank(tr, t, safe, planned)
-            if best is None or rank > best:
-                best, out = rank, (kind, tr, clear)
-        return out
+        ranked = [(self._fallback_rank(tr, t, safe, planned), kind, tr) for kind, tr in cands]
+        (_, clear), kind, tr = max(ranked, key=lambda c: c[0][0])  # the first on a tie
+        return kind, tr, clear
 
     def _fallback_rank(self, tr: Any, t: float, full: list[PredictedObstacle],
                        planned: list[PredictedObstacle]) -> tuple[tuple[Any, ...], float]:
