@@ -154,6 +154,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=None, help="also write the Markdown report here")
     ap.add_argument("--rows", default=None, help="also write every run's row as JSON here")
+    from anyplan.agents.settings import SettingsError
     from anyplan.cli.agent_options import add_agent_options, bench_configs
 
     add_agent_options(ap, bench=True)  # --set [PLANNER:]KEY=VALUE, --deterministic (as anyplan bench)
@@ -172,7 +173,10 @@ def main(argv: list[str] | None = None) -> int:
             planners.append(p)
         except ImportError:
             print(f"skipping {p}: not installed", file=sys.stderr)
-    configs = bench_configs(a, planners)
+    try:
+        configs = bench_configs(a, planners)
+    except SettingsError as exc:  # a bad --set: one line, exit 2, as anyplan bench
+        ap.error(str(exc))
     report = [f"# benchmarks/unknown.py ({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())})",
               "", "Command: `python benchmarks/unknown.py " + " ".join(sys.argv[1:] if argv is None
                                                                      else argv) + "`", ""]
