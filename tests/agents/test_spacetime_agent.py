@@ -13,7 +13,6 @@ from anyplan.agents import AGENTS, make_agent
 from anyplan.experiments.gaps import WALL_T, WALL_X, gap_world, issue_gap_scenario
 from anyplan.planning.sequential import SequentialConfig
 from anyplan.simulation import simulate
-from anyplan.trajectory.motion import polyline_trajectory
 from anyplan.world.scenario import scenario_from_dict
 from tests.conftest import fast_at_a_wall_dict
 
@@ -361,27 +360,3 @@ def test_fallback_never_brakes_into_a_wall_when_a_curve_clears_it():
     p = tr.positions(ts)
     clear = np.array([agent.obstacles.clearance(tuple(q)) for q in p]) - agent.spec.radius
     assert clear.min() >= 0.0
-
-
-def test_fallback_ranking_counts_a_hold_struck_at_rest_as_moving_free():
-    # The moving part of a brake or hold ends where the robot stands for good (its final hold),
-    # not at the horizon the hold is drawn to: a hold the obstacle reaches 2 s later is struck
-    # at rest, as in the guard's own ranking, while a drive into the obstacle is not.
-    from anyplan.prediction import PredictedObstacle
-    from anyplan.world import RobotState, UnicycleMotion
-
-    agent = _agent_in_empty_room(v_max=1.0, omega_max=1.0, a_max=1.0, alpha_max=2.0)
-    state = RobotState(4.0, 3.0, 0.0, 0.0, 0.0)
-    coming = [PredictedObstacle("C", 0.25, UnicycleMotion(7.0, 3.0, math.pi, 1.0), until=5.0)]
-    planned = agent._capped(coming)
-    cands = agent.guard.candidates(0.0, state, coming)
-    kind, hold, t_rest = cands[0]
-    assert kind == "hold" and t_rest == 0.0 and hold.t_end >= agent.guard.config.horizon_s
-    rank, _ = agent._fallback_rank(hold, 0.0, coming, planned)
-    free_full, free_planned, moving_free = rank[1:4]
-    assert not free_full and not free_planned and moving_free
-    dec = agent.guard.fallback(0.0, state, coming, "test")
-    assert dec.kind == "hold" and dec.safe  # the guard says the same
-    ahead = polyline_trajectory(np.array([[4.0, 3.0], [5.5, 3.0]]), agent.spec, state, 0.0,
-                                agent.obstacles)
-    assert not agent._fallback_rank(ahead, 0.0, coming, planned)[0][3]

@@ -32,7 +32,7 @@ from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import MotionModel, SequentialConfig, SequentialResult
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle, RadiusGrowth
 from anyplan.prediction.collision import first_collision
-from anyplan.trajectory.kinds import ST_PREFIX, MotionKind, SegmentKind
+from anyplan.trajectory.kinds import ST_PREFIX, MotionKind
 from anyplan.trajectory.motion import plan_motion, polyline_trajectory
 from anyplan.trajectory.spacetime import RowCache, retime, verify
 from anyplan.trajectory.trajectory import Trajectory
@@ -62,16 +62,6 @@ def _followable(tr: Any) -> bool:
     (``feasible``) without cutting a static or virtual obstacle (``certified_free``): only
     then is a prediction along ``tr`` one about where the robot goes."""
     return bool(getattr(tr, "feasible", True)) and bool(getattr(tr, "certified_free", True))
-
-
-def _rest_time(tr: Any) -> float:
-    """The time [s] from which the robot stands on ``tr`` for good: the start of its final hold
-    (a brake or hold fallback, or a hold that lasts "for ever"), else its end (a motion ends at
-    rest). Only the part before it is the *moving part* of a fallback."""
-    segs = getattr(tr, "segments", None)
-    if segs and segs[-1].kind == SegmentKind.HOLD:
-        return float(segs[-1].t0)
-    return float(tr.t_end)
 
 
 def warm_up_spacetime() -> None:
@@ -366,8 +356,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         Ranked, best first, by :meth:`_fallback_rank`: clear of the static obstacles (braking
         straight ahead beside a wall may not be); free over the guard's horizon against the
         full discs; then free over it against the discs planned against (capped growth,
-        ``plan_extra_m``); then its moving part free against the full discs (any contact would
-        find the robot at rest: the guard's own criterion); then the latest first contact
+        ``plan_extra_m``); then free against the full discs until the candidate ends (a motion
+        ends at rest; a hold or brake is drawn to the horizon, so unlike in the guard's own
+        ranking standing still is not free by default); then the latest first contact
         against the planned discs; then the largest clearance against the full discs. A hold
         that the planned discs run into is thus no longer preferred to a motion they leave
         free: standing still where an obstacle is predicted to pass is a collision too.
@@ -407,13 +398,13 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         :meth:`_evasions`) and its clearance [m] against the full discs over the horizon."""
         guard = self.guard
         cfg = guard.config
-        t_rest = max(_rest_time(tr), t)
-        h = max(t + cfg.horizon_s, t_rest)  # as the guard's own ranking
+        t_end = max(float(tr.t_end), t)
+        h = max(t + cfg.horizon_s, t_end)
         r = self.spec.radius
         clear = guard.clearance(tr, full, t, h)
         hit = first_collision(tr, planned, r, t_from=t, t_until=h, margin=cfg.margin,
                               sample_dt=cfg.sample_dt)
-        moving_free = first_collision(tr, full, r, t_from=t, t_until=t_rest, margin=cfg.margin,
+        moving_free = first_collision(tr, full, r, t_from=t, t_until=t_end, margin=cfg.margin,
                                       sample_dt=cfg.sample_dt) is None
         return (bool(getattr(tr, "certified_free", True)), clear >= cfg.margin, hit is None,
                 moving_free, math.inf if hit is None else float(hit.t), clear), clear
