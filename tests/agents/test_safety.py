@@ -219,3 +219,49 @@ def test_a_motion_the_robot_cannot_take_up_is_not_started():
     d = guard.decide(0.0, motion, None, state, [_parked_disc("far", 6.0, 7.0)], 0.3)
     assert d.kind in FALLBACK_KINDS and "infeasible" in d.reason
     assert d.trajectory.state(0.0).v == pytest.approx(2.0)
+
+
+def test_reachable_discs_contain_every_bounded_speed_future():
+    # Whatever an obstacle does at up to its predicted speed + extra, it stays in its disc;
+    # an obstacle behind the robot is left out.
+    from anyplan.agents.safety import reachable_discs
+
+    rng = np.random.default_rng(3)
+    ahead = PredictedObstacle("A", 0.3, UnicycleMotion(4.0, 4.0, math.pi, 0.8, 0.0))
+    behind = PredictedObstacle("B", 0.3, UnicycleMotion(0.0, 4.0, 0.0, 0.8, 0.0))
+    discs = reachable_discs([ahead, behind], 1.0, np.array([1.0, 4.0]), 0.0, 0.2, 5.0)
+    assert [d.name for d in discs] == ["A"]
+    d = discs[0]
+    q0 = ahead.positions(np.array([1.0]))[0]
+    for _ in range(200):  # random piecewise-constant velocities of norm <= 1.0 m/s
+        q, t = q0.copy(), 1.0
+        for _ in range(5):
+            dt = rng.uniform(0.0, 0.8)
+            ang, sp = rng.uniform(-math.pi, math.pi), rng.uniform(0.0, 1.0)
+            q = q + sp * dt * np.array([math.cos(ang), math.sin(ang)])
+            t += dt
+            centre = d.positions(np.array([t]))[0]
+            assert math.hypot(*(q - centre)) + 0.3 <= float(d.radius_at(t)) + 1e-9
+
+
+def test_passive_safety_refuses_speed_an_obstacle_could_cut_into():
+    # An obstacle 1.5 m ahead of a robot cruising at 0.4 m/s drives away at 0.5 m/s: the
+    # prediction is free, but if it turned back it could meet the robot still braking (commit
+    # 0.3 s + 1 s of braking against 1.5 - 0.6 = 0.9 m at 0.7 m/s closing). Without the
+    # reachable discs the motion starts; with them it does not, and the guard brakes.
+    from anyplan.agents.safety import reachable_discs
+
+    guard = SafetyGuard(SPEC, ROOM)
+    state, motion = _cruising()
+    away = [PredictedObstacle("W", 0.3, UnicycleMotion(2.5, 4.0, 0.0, 0.5, 0.0))]
+    assert guard.check(motion, away, 0.0, 0.3)[0] == "free_to_rest"
+    reach = reachable_discs(away, 0.0, np.array([1.0, 4.0]), 0.0, 0.2, 5.0)
+    assert guard.check(motion, away, 0.0, 0.3, reach=reach)[0] == "unsafe"
+    d = guard.decide(0.0, motion, None, state, away, 0.3, reach)
+    assert d.kind == "brake"
+    # Far away (6 m ahead) the same motion is passively safe, and a robot at rest always is.
+    far = [PredictedObstacle("W", 0.3, UnicycleMotion(7.0, 4.0, 0.0, 0.5, 0.0))]
+    reach_far = reachable_discs(far, 0.0, np.array([1.0, 4.0]), 0.0, 0.2, 5.0)
+    assert guard.check(motion, far, 0.0, 0.3, reach=reach_far)[0] != "unsafe"
+    hold = guard.fallback(0.0, RobotState(1.0, 4.0, 0.0, 0.0, 0.0), []).trajectory
+    assert guard.check(hold, away, 0.0, 0.0, reach=reach)[0] != "unsafe"

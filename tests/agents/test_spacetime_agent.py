@@ -98,7 +98,7 @@ def test_result_fields():
     d = json.loads(json.dumps(r.to_dict()))
     ex = d["extra"]
     assert isinstance(ex["fallbacks"], list)
-    assert all(set(f) >= {"t", "kind", "reason", "predicted_collision_s"} for f in ex["fallbacks"])
+    assert all(set(f) >= {"t", "kind", "reason", "predicted_clearance_m"} for f in ex["fallbacks"])
     assert len(ex["st_waits_s"]) == len(d["plans"]) and all(w >= 0.0 for w in ex["st_waits_s"])
     assert 0 <= ex["st_timed"] <= len(d["plans"])
     assert len(ex["st_candidates"]) == len(d["planning_times_s"])
@@ -124,11 +124,12 @@ def test_holds_and_records_a_fallback_when_nothing_is_safe():
                                "radius": 0.3}]})
     r = simulate(sc, make_agent("st-bitstar", planning_delay=0.1), seed=0)
     fb = r.extra["fallbacks"]
-    assert fb and all(f["kind"] == "brake-hold" for f in fb)
-    assert r.plans[0]["kind"] == "fallback-hold"
-    # The robot never drove towards the obstacle: it is hit while at rest (not robot-caused).
+    assert fb and all(f["kind"] in ("hold", "back_off", "evade", "turn_away") for f in fb)
+    assert all(set(f) >= {"t", "kind", "reason", "predicted_clearance_m"} for f in fb)
+    # The robot never drove towards the obstacle (+x); if it is hit, it did not cause it.
     tr = r.trajectory_array
-    assert np.max(np.abs(tr[:, 4])) < 0.05
+    assert np.max(tr[:, 4] * np.cos(tr[:, 3])) < 0.05
+    assert not r.collision or r.collision_robot_caused is False
 
 
 def test_planning_predictions_of_uncertain_obstacles():
@@ -174,6 +175,11 @@ def test_evasion_beats_holding_before_a_fast_obstacle():
 
 def test_guard_option():
     assert make_agent("st-bitstar", guard="never").guard_mode == "never"
+    assert make_agent("st-bitstar", passive_safety=True).passive_safety is True
+    with pytest.raises(ValueError, match="passive_safety"):
+        make_agent("st-bitstar", passive_safety="yes")
+    with pytest.raises(ValueError, match="reach_extra_mps"):
+        make_agent("st-bitstar", reach_extra_mps=-0.1)
     with pytest.raises(ValueError, match="guard"):
         make_agent("st-bitstar", guard="sometimes")
 
@@ -202,9 +208,9 @@ def test_guard_of_a_safety_replanning_checks_the_full_discs():
     seen = []
     decide = agent.guard.decide
 
-    def spy(t_s, motion, current, state, preds, commit):
+    def spy(t_s, motion, current, state, preds, commit, reach=()):
         seen.append(list(preds))
-        return decide(t_s, motion, current, state, preds, commit)
+        return decide(t_s, motion, current, state, preds, commit, reach)
 
     agent.guard.decide = spy
     agent._check(Observation(t, st), [ahead])
@@ -360,3 +366,31 @@ def test_fallback_never_brakes_into_a_wall_when_a_curve_clears_it():
     p = tr.positions(ts)
     clear = np.array([agent.obstacles.clearance(tuple(q)) for q in p]) - agent.spec.radius
     assert clear.min() >= 0.0
+
+
+def test_fallback_struck_at_rest_beats_one_struck_later_driving_into_it():
+    # Every candidate is predicted struck: a hold at (3, 3), struck at rest by an obstacle coming
+    # west at 1 m/s, ranks before a slow drive east into the same obstacle struck later: the
+    # robot would be driving into it (approach 0.2 m/s > 0.05), a robot-caused collision.
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.prediction.collision import first_collision
+    from anyplan.trajectory.motion import polyline_trajectory
+    from anyplan.trajectory.reference import HoldSegment
+    from anyplan.trajectory.trajectory import Trajectory
+    from anyplan.world import RobotState, UnicycleMotion
+
+    agent = _agent_in_empty_room(v_max=0.2, omega_max=1.0, a_max=1.0, alpha_max=2.0)
+    west = [PredictedObstacle("W", 0.25, UnicycleMotion(12.0, 3.0, math.pi, 1.0))]
+    hold = Trajectory([HoldSegment(3.0, 3.0, 0.0, 0.0, 12.0)], kind="hold")
+    drive = polyline_trajectory(np.array([[1.0, 3.0], [7.0, 3.0]]), agent.spec,
+                                RobotState(1.0, 3.0, 0.0, 0.0, 0.0), 0.0, agent.obstacles,
+                                agent.spec.radius)
+    r, m = agent.spec.radius, agent.guard.config.margin
+    h_hold = first_collision(hold, west, r, t_from=0.0, t_until=12.0, margin=m)
+    h_drive = first_collision(drive, west, r, t_from=0.0, t_until=drive.t_end, margin=m)
+    assert h_hold is not None and h_drive is not None and h_drive.t > h_hold.t
+    assert drive.state(h_drive.t).v > 0.15  # driving east, into the obstacle, at contact
+    k_hold, _ = agent._fallback_rank(hold, 0.0, west, west)
+    k_drive, _ = agent._fallback_rank(drive, 0.0, west, west)
+    assert k_hold > k_drive
+    assert k_hold[:4] == k_drive[:4]  # tied on everything before the approach speed

@@ -24,14 +24,15 @@ import numpy as np
 from anyplan.config import setting, validate
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.moving import closest_approach
-from anyplan.prediction.base import PredictedObstacle
+from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
 from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.motion import brake_to_rest, polyline_trajectory
 from anyplan.trajectory.reference import HoldSegment, come_to_rest
 from anyplan.trajectory.trajectory import BrakeSegment, Trajectory
+from anyplan.world.motion import UnicycleMotion
 from anyplan.world.robot import RobotSpec, RobotState
 
-__all__ = ["SafetyConfig", "Decision", "Escape", "SafetyGuard", "FALLBACK_KINDS"]
+__all__ = ["SafetyConfig", "Decision", "Escape", "SafetyGuard", "FALLBACK_KINDS", "reachable_discs"]
 
 #: The fallback kinds, in order of preference when their clearances tie.
 FALLBACK_KINDS = ("hold", "brake", "turn_away", "back_off")
@@ -167,8 +168,18 @@ class SafetyGuard:
                                margin=margin, sample_dt=self.config.sample_dt)
 
     def check(self, motion: Any, preds: Sequence[PredictedObstacle], t: float, commit_s: float,
-              margin: float | None = None) -> tuple[str, float | None, float | None, float | None]:
+              margin: float | None = None, reach: Sequence[PredictedObstacle] = ()
+              ) -> tuple[str, float | None, float | None, float | None]:
         """Whether ``motion`` may be started (or kept) at ``t`` [s].
+
+        With ``reach`` (discs that contain everywhere an obstacle whose future is unknown can
+        be, :func:`reachable_discs`), the motion must also be *passively safe*: its escape
+        brings the robot to rest before any of them can touch it, so that a collision with an
+        obstacle that leaves its prediction finds the robot at rest, not driving into it
+        (Macek, Vasquez, Fraichard & Siegwart, "Towards safe vehicle navigation in dynamic
+        urban scenarios", Automatika 2009; Bouraine, Fraichard & Salhi, "Provably safe
+        navigation for mobile robots with limited field-of-views in dynamic environments",
+        Autonomous Robots 2012).
 
         Returns:
             ``(rule, t_commit, t_rest, first_collision_s)`` with rule ``"free_to_rest"``,
@@ -177,24 +188,32 @@ class SafetyGuard:
         m = self.config.margin if margin is None else margin
         t_end = max(float(motion.t_end), t)
         hit = self._hit(motion, preds, t, t_end, m)
+        esc = None
+        if reach:
+            esc = Escape(motion, t + commit_s, self.spec, self.obstacles, self.spec.radius)
+            if self._hit(esc, reach, t, esc.t_rest, m) is not None:
+                return "unsafe", esc.t_commit, esc.t_rest, None if hit is None else hit.t
         if hit is None:
             return "free_to_rest", None, t_end, None
-        esc = Escape(motion, t + commit_s, self.spec, self.obstacles, self.spec.radius)
+        if esc is None:
+            esc = Escape(motion, t + commit_s, self.spec, self.obstacles, self.spec.radius)
         if esc.static_free and self._hit(esc, preds, t, esc.t_rest, m) is None:
             return "stoppable", esc.t_commit, esc.t_rest, hit.t
         return "unsafe", esc.t_commit, esc.t_rest, hit.t
 
     def still_safe(self, current: Any, preds: Sequence[PredictedObstacle], t: float,
-                   commit_s: float) -> bool:
+                   commit_s: float, reach: Sequence[PredictedObstacle] = ()) -> bool:
         """True if the current motion still satisfies the rule from ``t`` [s] (with the
-        re-check margin)."""
+        re-check margin; passively safe against ``reach``, see :meth:`check`)."""
         if current is None:
             return True
-        return self.check(current, preds, t, commit_s, self.config.recheck_margin)[0] != "unsafe"
+        return self.check(current, preds, t, commit_s, self.config.recheck_margin,
+                          reach)[0] != "unsafe"
 
     # --- decisions ---------------------------------------------------------------------------
     def decide(self, t: float, motion: Any, current: Any, state: RobotState,
-               preds: Sequence[PredictedObstacle], commit_s: float) -> Decision:
+               preds: Sequence[PredictedObstacle], commit_s: float,
+               reach: Sequence[PredictedObstacle] = ()) -> Decision:
         """Start ``motion``, keep ``current``, or fall back (see the module docstring).
 
         Args:
@@ -204,6 +223,8 @@ class SafetyGuard:
             state: The robot's state at ``t`` (on ``current``, or its own).
             preds: Predicted moving obstacles.
             commit_s: Time [s] before the agent can act again.
+            reach: Reachable discs a started or kept motion must be passively safe against
+                (:meth:`check`); the fallbacks are ranked against ``preds``.
         """
         reason = "no motion proposed"
         if motion is not None and not getattr(motion, "feasible", True):
@@ -211,12 +232,14 @@ class SafetyGuard:
             # predicted along it is not where the robot goes.
             reason = "proposed motion: infeasible from the robot's state"
         elif motion is not None:
-            rule, tc, tr, fc = self.check(motion, preds, t, commit_s)
+            rule, tc, tr, fc = self.check(motion, preds, t, commit_s, reach=reach)
             if rule != "unsafe":
                 return self._log(Decision(t, "motion", motion, True, rule, tc, tr, fc))
-            reason = f"proposed motion: collision predicted at {fc:.2f} s, cannot stop before it"
+            reason = ("proposed motion: cannot stop before an obstacle could reach it"
+                      if fc is None else
+                      f"proposed motion: collision predicted at {fc:.2f} s, cannot stop before it")
         if current is not None and t < current.t_end + 1e-9:
-            rule, tc, tr, fc = self.check(current, preds, t, commit_s)
+            rule, tc, tr, fc = self.check(current, preds, t, commit_s, reach=reach)
             if rule != "unsafe":
                 return self._log(Decision(t, "keep", current, True, rule, tc, tr, fc))
         return self._log(self.fallback(t, state, preds, reason))
@@ -335,6 +358,30 @@ class SafetyGuard:
         cands = [(s[5], bool(s[1]), float(s[2])) for s in scored]
         return Decision(t, best[5], best[6], bool(best[1]), "fallback", None, best[7], None,
                         float(best[2]), cands, reason)
+
+
+def reachable_discs(preds: Sequence[PredictedObstacle], t: float, p: np.ndarray, heading: float,
+                    extra_speed: float, horizon_s: float) -> list[PredictedObstacle]:
+    """Discs [m] that contain, from ``t`` [s] on, every position an obstacle of ``preds`` can
+    reach whatever it does, if its speed stays within its predicted speed plus ``extra_speed``
+    [m/s]: centred where it is predicted at ``t``, with its radius there, growing at that speed
+    up to ``horizon_s`` [s] (then held). Only obstacles not behind the robot at ``p``, heading
+    ``heading`` [rad], are kept: one behind it meets a robot moving away (or at rest), which is
+    not the robot driving into it.
+    """
+    u = np.array([math.cos(heading), math.sin(heading)])
+    out = []
+    for o in preds:
+        if float(getattr(o, "until", math.inf)) < t:
+            continue
+        q = o.positions(np.array([t]))[0]
+        if float(np.dot(q - p, u)) < 0.0:
+            continue
+        speed = float(o.max_speed) + extra_speed
+        growth = RadiusGrowth(t, np.array([0.0, horizon_s]), np.array([0.0, speed * horizon_s]))
+        out.append(PredictedObstacle(o.name, float(o.radius_at(t)),
+                                     UnicycleMotion(float(q[0]), float(q[1]), 0.0, 0.0), growth))
+    return out
 
 
 def _max_radius(o: Any) -> float:

@@ -26,14 +26,14 @@ from typing import Any
 import numpy as np
 
 from anyplan.agents.base import Observation
+from anyplan.agents.evasion import FallbackRanker, best_fallback
+from anyplan.agents.safety import reachable_discs
 from anyplan.agents.sequential import SequentialBITStarAgent
 from anyplan.agents.stats import SpaceTimeStats
 from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import MotionModel, SequentialConfig, SequentialResult
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle, RadiusGrowth
-from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.kinds import ST_PREFIX, MotionKind
-from anyplan.trajectory.motion import plan_motion, polyline_trajectory
 from anyplan.trajectory.spacetime import RowCache, retime, verify
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import RobotState
@@ -129,6 +129,14 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             (:func:`~anyplan.prediction.base.manoeuvre_growth`), so they are uncertain and the
             receding horizon and the guard apply to them as to tracked ones. 0: exact twists
             are planned against in full (the default; docs/perception.md has the figures).
+        passive_safety: With predictions of unknown futures (``twist``, ``tracked``), every
+            motion started or kept must also be passively safe: its escape brings the robot to
+            rest before any obstacle ahead could reach it at its predicted speed plus
+            ``reach_extra_mps`` (:func:`~anyplan.agents.safety.reachable_discs`), so that an
+            obstacle leaving its prediction (turning at a corner) meets a robot at rest, not
+            one driving into it. The robot slows down near obstacles it cannot predict.
+        reach_extra_mps: Speed [m/s] added to each obstacle's predicted speed for its
+            reachable disc.
         **kwargs: Further options of :class:`SequentialBITStarAgent` (planning_delay, ...).
     """
 
@@ -140,6 +148,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                  max_wait_s: float = 30.0, lattice_dt_s: float = 0.25, accept_s: float = 0.5,
                  horizon_s: float | None = 3.0, plan_extra_m: float | None = 0.3,
                  guard: str = "growth", manoeuvre_accel: float = 0.0,
+                 passive_safety: bool = False, reach_extra_mps: float = 0.3,
                  **kwargs: Any) -> None:
         loop = {k: kwargs.pop(k) for k in list(kwargs) if k in _LOOP_FIELDS}  # e.g. from --set
         if config is None:
@@ -160,6 +169,12 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         if not (isinstance(manoeuvre_accel, int | float) and manoeuvre_accel >= 0.0):
             raise ValueError(f"manoeuvre_accel: must be >= 0, got {manoeuvre_accel!r}")
         self.manoeuvre_accel = float(manoeuvre_accel)
+        if not isinstance(passive_safety, bool):
+            raise ValueError(f"passive_safety: must be true or false, got {passive_safety!r}")
+        self.passive_safety = passive_safety
+        if not (isinstance(reach_extra_mps, int | float) and reach_extra_mps >= 0.0):
+            raise ValueError(f"reach_extra_mps: must be >= 0, got {reach_extra_mps!r}")
+        self.reach_extra_mps = float(reach_extra_mps)
         if plan_extra_m is not None and not (isinstance(plan_extra_m, int | float)
                                              and plan_extra_m >= 0.0):
             raise ValueError(f"plan_extra_m: must be >= 0 or null, got {plan_extra_m!r}")
@@ -184,6 +199,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         self._rows: RowCache | None = None
         #: Nominal motions of this replanning and whether each is free as timed (``_timed_fn``).
         self._nominals: dict[tuple[Any, ...], tuple[Trajectory, bool | None, list[Shape]]] = {}
+        #: The predictions of unknown futures (a horizon, no announced motion) last observed.
+        self._unknown: list[PredictedObstacle] = []
 
     def _new_record(self) -> SpaceTimeStats:
         return SpaceTimeStats()
@@ -333,98 +350,72 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         (hold, brake, turn away, back off). Returns the decision's kind and trajectory."""
         commit = self.check_period_s + max(t_switch - obs.t, 0.0)
         state = self._state_at(obs, t_switch)
-        dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit)
+        reach = self._reach(t_switch, state)
+        dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit, reach)
         if dec.kind in ("motion", "keep"):
             return dec.kind, dec.trajectory
-        kind, tr, clear = self._evasions(t_switch, state, safe, motion, self.trajectory)
+        kind, tr, clear = self._evasions(t_switch, state, safe, motion, self.trajectory, reach)
         self.record.fallbacks.append(
             {"t": float(obs.t), "kind": kind, "reason": dec.reason or reason,
              "predicted_clearance_m": _finite(clear)})
         return kind, tr
 
-    def _evasions(self, t: float, state: RobotState, safe: list[PredictedObstacle],
-                  motion: Trajectory | None, current: Trajectory | None = None
-                  ) -> tuple[str, Any, float]:
-        """The best fallback, with its clearance [m], among the guard's (hold or brake, turn
-        away, back off), the proposed ``motion``, driving ``v_max x 1.5 s`` in one of 8
-        directions, along a straight line from rest and, when the robot moves, along a smooth
-        curve from its speed and heading (obstacles that ignore the robot are escaped by
-        moving, not only by stopping), and, last (only when strictly better), keeping the
-        motion in use (``current``: e.g. the curve that clears a wall when braking straight
-        would not).
+    def _reach(self, t: float, state: RobotState) -> list[PredictedObstacle]:
+        """The reachable discs at ``t`` [s] of the obstacles whose future is unknown
+        (``passive_safety``; empty when it is off or every motion is announced)."""
+        if not self.passive_safety or not self._unknown:
+            return []
+        h = self.guard.config.horizon_s
+        return reachable_discs(self._unknown, t, np.array([state.x, state.y]), state.theta,
+                               self.reach_extra_mps, h)
 
-        Ranked, best first, by :meth:`_fallback_rank`: clear of the static obstacles (braking
-        straight ahead beside a wall may not be); free over the guard's horizon against the
-        full discs; then free over it against the discs planned against (capped growth,
-        ``plan_extra_m``); then free against the full discs until the candidate ends (a motion
-        ends at rest; a hold or brake is drawn to the horizon, so unlike in the guard's own
-        ranking standing still is not free by default); then the latest first contact
-        against the planned discs; then the largest clearance against the full discs. A hold
-        that the planned discs run into is thus no longer preferred to a motion they leave
-        free: standing still where an obstacle is predicted to pass is a collision too.
-        """
-        spec = self.spec
-        cands: list[tuple[str, Any]] = [(kind, tr) for kind, tr, _ in
-                                        self.guard.candidates(t, state, safe)]
-        if motion is not None:
-            cands.append(("motion", motion))
-        p0 = np.array([state.x, state.y])
-        radius = spec.radius + self.guard.config.margin
-        dist = 1.5 * spec.v_max
-        for k in range(8):
-            a = state.theta + k * math.pi / 4.0
-            target = p0 + dist * np.array([math.cos(a), math.sin(a)])
-            if not self.obstacles.segment_free(p0, target, radius):
-                continue
-            tr = polyline_trajectory(np.array([p0, target]), spec, state, t, self.obstacles, radius)
-            if tr.certified_free:
-                cands.append(("evade", tr))
-            if abs(state.v) > 1e-3:
-                # and a smooth curve there from the current speed and heading (no braking first)
-                tr = plan_motion(np.array([p0, target]), spec, state, self.obstacles, t,
-                                 allow_turn=False)
-                if tr.certified_free and tr.feasible:
-                    cands.append(("evade", tr))
-        if current is not None and t < float(current.t_end) - 1e-9:
-            cands.append(("keep", current))
-        planned = self._capped(safe)
-        ranked = [(self._fallback_rank(tr, t, safe, planned), kind, tr) for kind, tr in cands]
-        (_, clear), kind, tr = max(ranked, key=lambda c: c[0][0])  # the first on a tie
-        return kind, tr, clear
+    def _evasions(self, t: float, state: RobotState, safe: list[PredictedObstacle],
+                  motion: Trajectory | None, current: Trajectory | None = None,
+                  reach: Sequence[PredictedObstacle] = ()) -> tuple[str, Any, float]:
+        """The best fallback from ``state`` at ``t`` [s], with its clearance [m]:
+        :func:`anyplan.agents.evasion.best_fallback` against the full predictions ``safe``
+        and the capped ones planned against, ``reach`` with ``passive_safety``."""
+        return best_fallback(self._ranker(), t, state, safe, self._capped(safe), motion,
+                             current, reach)
 
     def _fallback_rank(self, tr: Any, t: float, full: list[PredictedObstacle],
-                       planned: list[PredictedObstacle]) -> tuple[tuple[Any, ...], float]:
-        """The ranking key of fallback ``tr`` from ``t`` [s] (larger is better, see
-        :meth:`_evasions`) and its clearance [m] against the full discs over the horizon."""
-        guard = self.guard
-        cfg = guard.config
-        t_end = max(float(tr.t_end), t)
-        h = max(t + cfg.horizon_s, t_end)
-        r = self.spec.radius
-        clear = guard.clearance(tr, full, t, h)
-        hit = first_collision(tr, planned, r, t_from=t, t_until=h, margin=cfg.margin,
-                              sample_dt=cfg.sample_dt)
-        moving_free = first_collision(tr, full, r, t_from=t, t_until=t_end, margin=cfg.margin,
-                                      sample_dt=cfg.sample_dt) is None
-        return (bool(getattr(tr, "certified_free", True)), clear >= cfg.margin, hit is None,
-                moving_free, math.inf if hit is None else float(hit.t), clear), clear
+                       planned: list[PredictedObstacle], reach: Sequence[PredictedObstacle] = ()
+                       ) -> tuple[tuple[Any, ...], float]:
+        """The ranking key of fallback ``tr`` (:meth:`FallbackRanker.rank
+        <anyplan.agents.evasion.FallbackRanker.rank>`) and its clearance [m]."""
+        return self._ranker().rank(tr, t, full, planned, reach)
+
+    def _ranker(self) -> FallbackRanker:
+        return FallbackRanker(self.spec, self.obstacles, self.guard, self.check_period_s)
 
     def _fallback(self, obs: Observation, t_switch: float, preds: list[PredictedObstacle],
-                  reason: str) -> Trajectory:
-        """Brake to rest on the current reference (or stay) and hold."""
+                  reason: str) -> Trajectory | None:
+        """No motion was found and the one in use is no longer free (certain predictions, no
+        guard): the best fallback of :meth:`_evasions` (brake or hold, turn away, back off,
+        evade, or keep the motion in use when strictly better), ranked by predicted clearance,
+        never a blind brake. Before, braking on the current reference was the only fallback:
+        in DynaBARN world 58 (``twist``) the robot braked straight into the path of an
+        obstacle that had just turned, its collision predicted 0.9 s ahead, while turning away
+        was free. Returns None to keep the motion in use."""
         state = self._state_at(obs, t_switch)
-        tr, t_rest = self.reference.hold(state, t_switch, 1e4, kind=MotionKind.FALLBACK_HOLD,
-                                         stop_rotation=False)
-        hit = verify(tr, preds, self.spec.radius, t_until=t_rest + 10.0) if preds else None
+        if not preds:
+            tr, _ = self.reference.hold(state, t_switch, 1e4, kind=MotionKind.FALLBACK_HOLD,
+                                        stop_rotation=False)
+            kind, clear = "brake-hold", math.inf
+        else:
+            kind, tr, clear = self._evasions(t_switch, state, preds, None, self.trajectory)
+        if kind == "keep":
+            return None
         self.record.fallbacks.append(
-            {"t": float(obs.t), "kind": "brake-hold", "reason": reason,
-             "predicted_collision_s": None if hit is None else float(hit.t)})
+            {"t": float(obs.t), "kind": kind, "reason": reason,
+             "predicted_clearance_m": _finite(clear)})
         return tr
 
     # --- planning --------------------------------------------------------------------------------
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
         dt, d, t_ready, state = self._begin_replan(obs)
         t = obs.t
+        self._unknown = [o for o in preds if o.until < math.inf]
         preds, safe = self._split(preds, np.array([state.x, state.y]), t_ready)
         uncertain = safe is not None
         self._cands = []
@@ -469,8 +460,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         # really have, on the same path (no new search).
         t_switch, motion = self._take_up(obs, t_ready, wall, d, dt, motion,
                                          lambda state, t_s: self._retime_path(state, t_s, path, shapes))
-        if safe is not None and self._guarded_by(safe):
-            kind, motion = self._guard(obs, t_switch, motion, safe, res.status)
+        if (safe is not None and self._guarded_by(safe)) or (self.passive_safety and self._unknown):
+            kind, motion = self._guard(obs, t_switch, motion, preds if safe is None else safe,
+                                       res.status)
             if kind == "keep":
                 return
             if kind != "motion":
@@ -478,16 +470,23 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 self.pending = (t_switch, motion)  # type: ignore[assignment]
                 return
         if motion is None:
+            # (checked at least the fallback horizon ahead: a motion that has ended leaves the
+            # robot standing at its end, which is not free when an obstacle is to pass there)
             if self.trajectory is not None and verify(
                     self.trajectory, preds, self.spec.radius, t_from=t_switch,
-                    t_until=min(self.trajectory.t_end, t_switch + _CHECK_HORIZON_S)) is None:
+                    t_until=max(min(self.trajectory.t_end, t_switch + _CHECK_HORIZON_S),
+                                t_switch + self.guard.config.horizon_s)) is None:
                 return  # the current reference is still free: keep it, try again later
-            motion = self._fallback(obs, t_switch, preds, res.status)
-        else:
-            self._fallback_active = False
-            self._path, self._shapes = np.asarray(path), list(shapes)
-            self.record.st_timed += int(motion.kind.startswith(ST_PREFIX))
-            self.record.st_waits_s.append(float(motion.info.get("wait_s", 0.0)))
+            fb = self._fallback(obs, t_switch, preds, res.status)
+            if fb is None:
+                return  # keeping the motion in use ranks best
+            self._fallback_active = True
+            self.pending = (t_switch, fb)
+            return
+        self._fallback_active = False
+        self._path, self._shapes = np.asarray(path), list(shapes)
+        self.record.st_timed += int(motion.kind.startswith(ST_PREFIX))
+        self.record.st_waits_s.append(float(motion.info.get("wait_s", 0.0)))
         self.stats.plans.append({"t": t, "t_start": t_switch, "path": np.asarray(path).tolist(),
                                  "status": res.status, "kind": motion.kind,
                                  "virtual_obstacles": len(res.virtual_obstacles),
@@ -527,9 +526,11 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             return
         # ``_replan`` is given the predictions as observed (``preds``): it splits them itself,
         # so that its guard checks the full discs, not the capped ones planned against.
+        self._unknown = [o for o in preds if o.until < math.inf]
         planned, safe = self._split(preds, np.array([obs.robot.x, obs.robot.y]), t)
-        if safe is not None and self._guarded_by(safe) and not self.guard.still_safe(
-                traj, safe, t, self.check_period_s + 0.1):
+        reach = self._reach(t, obs.robot)
+        if ((safe is not None and self._guarded_by(safe)) or reach) and not self.guard.still_safe(
+                traj, planned if safe is None else safe, t, self.check_period_s + 0.1, reach):
             self._replan(obs, preds, "safety: the motion in use can no longer stop in time")
             return
         hit = verify(traj, planned, spec.radius, t_from=t,

@@ -1,0 +1,160 @@
+"""Fallbacks of ``st-bitstar``: the candidates when no planned motion may start, and their ranking.
+
+The safety guard (:mod:`anyplan.agents.safety`) offers hold or brake, turn away and back off;
+``st-bitstar`` adds the proposed motion, evasions in 8 directions (straight after braking and,
+when the robot moves, a smooth curve from its speed and heading) and, last, keeping the motion
+in use, and ranks them all by :meth:`FallbackRanker.rank`. ``docs/perception.md``,
+"Fallbacks", has the ranking's reasons and measurements.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from anyplan.agents.safety import Escape, SafetyGuard
+from anyplan.geometry.collision import ObstacleSet
+from anyplan.prediction.base import PredictedObstacle
+from anyplan.prediction.collision import PredictedCollision, first_collision
+from anyplan.trajectory.motion import plan_motion, polyline_trajectory
+from anyplan.world.robot import RobotSpec, RobotState
+
+__all__ = ["APPROACH_TOL", "FallbackRanker", "approach_speed", "best_fallback"]
+
+#: Approach speed [m/s] at a predicted contact below which it counts as none (at rest or
+#: moving away; well below the 0.05 m/s robot-caused threshold of
+#: :mod:`anyplan.simulation.contact`, which a slow creep at contact would cross on execution).
+APPROACH_TOL = 1e-3
+
+
+#: Times [s] after a predicted contact at which the approach speed is taken too.
+_AFTER_CONTACT_S = (0.0, 0.1, 0.2, 0.3)
+
+
+def approach_speed(tr: Any, hit: PredictedCollision | None) -> float:
+    """The robot's largest speed [m/s] towards the obstacle at predicted contact ``hit`` on
+    ``tr`` and in the 0.3 s after it (0 without a contact, or at most :data:`APPROACH_TOL`;
+    the direction is the one at contact): when every fallback is struck,
+    the one that meets the obstacle at rest or moving away, not driving into it, ranks first.
+
+    Examples:
+        >>> from anyplan.trajectory.reference import HoldSegment
+        >>> from anyplan.trajectory.trajectory import Trajectory
+        >>> hold = Trajectory([HoldSegment(0.0, 0.0, 0.0, 0.0, 5.0)], kind="hold")
+        >>> hit = PredictedCollision("O", 1.0, np.zeros(2), np.array([0.5, 0.0]), 0.2)
+        >>> approach_speed(hold, hit)
+        0.0
+    """
+    if hit is None:
+        return 0.0
+    u = np.asarray(hit.obstacle_position, dtype=float) - np.asarray(hit.robot_position, dtype=float)
+    n = float(np.hypot(*u))
+    if n < 1e-9:
+        return 0.0
+    a = 0.0
+    # at contact and just after it (a robot that sets off at the contact drives into it too)
+    for dt in _AFTER_CONTACT_S:
+        st = tr.state(min(float(hit.t) + dt, max(float(tr.t_end), float(hit.t))))
+        a = max(a, st.v * (math.cos(st.theta) * u[0] + math.sin(st.theta) * u[1]) / n)
+    return a if a > APPROACH_TOL else 0.0
+
+
+class FallbackRanker:
+    """Ranks fallback trajectories of a robot among predicted obstacles.
+
+    Args:
+        spec: The robot.
+        obstacles: Static obstacles with walls.
+        guard: The safety guard (its margin, horizon, sampling and clearance search).
+        commit_s: Time [s] a fallback is followed before the robot can act again (the escape
+            of the passive-safety check).
+    """
+
+    def __init__(self, spec: RobotSpec, obstacles: ObstacleSet, guard: SafetyGuard,
+                 commit_s: float) -> None:
+        self.spec = spec
+        self.obstacles = obstacles
+        self.guard = guard
+        self.commit_s = float(commit_s)
+
+    def rank(self, tr: Any, t: float, full: Sequence[PredictedObstacle],
+             planned: Sequence[PredictedObstacle], reach: Sequence[PredictedObstacle] = ()
+             ) -> tuple[tuple[Any, ...], float]:
+        """The ranking key of fallback ``tr`` from ``t`` [s] (larger is better) and its
+        clearance [m] against the ``full`` discs over the guard's horizon.
+
+        Best first: clear of the static obstacles (braking straight ahead beside a wall may
+        not be); passively safe against ``reach`` (only when given:
+        :func:`~anyplan.agents.safety.reachable_discs`); free over the horizon against the
+        full discs; then free over it against the ``planned`` (capped) discs; then, when the
+        planned discs strike it, met at rest or moving away rather than driving into the
+        obstacle (:func:`approach_speed`); then the latest first contact against the planned
+        discs; then the largest clearance against the full discs. A hold the planned discs run
+        into thus loses to a motion they leave free (standing where an obstacle passes is a
+        collision too), and a short drive that stops just before an obstacle arrives does not
+        beat a hold struck later.
+        """
+        guard = self.guard
+        cfg = guard.config
+        h = max(t + cfg.horizon_s, float(tr.t_end), t)
+        r = self.spec.radius
+        passive = True
+        if reach:
+            esc = Escape(tr, t + self.commit_s, self.spec, self.obstacles, r)
+            passive = first_collision(esc, reach, r, t_from=t, t_until=max(esc.t_rest, t),
+                                      margin=cfg.margin, sample_dt=cfg.sample_dt) is None
+        clear = guard.clearance(tr, full, t, h)
+        hit = first_collision(tr, planned, r, t_from=t, t_until=h, margin=cfg.margin,
+                              sample_dt=cfg.sample_dt)
+        return (bool(getattr(tr, "certified_free", True)), passive, clear >= cfg.margin,
+                hit is None, -approach_speed(tr, hit),
+                math.inf if hit is None else float(hit.t), clear), clear
+
+    def candidates(self, t: float, state: RobotState, safe: Sequence[PredictedObstacle],
+                   motion: Any = None, current: Any = None) -> list[tuple[str, Any]]:
+        """``(kind, trajectory)`` of every fallback from ``state`` at ``t`` [s]: the guard's
+        (hold or brake, turn away, back off), the proposed ``motion``, driving
+        ``v_max x 1.5 s`` in one of 8 directions along a straight line from rest and, when the
+        robot moves, along a smooth curve from its speed and heading (obstacles that ignore
+        the robot are escaped by moving, not only by stopping), and, last, keeping ``current``
+        (e.g. the curve that clears a wall when braking straight would not)."""
+        spec, obstacles = self.spec, self.obstacles
+        cands: list[tuple[str, Any]] = [(kind, tr) for kind, tr, _ in
+                                        self.guard.candidates(t, state, safe)]
+        if motion is not None:
+            cands.append(("motion", motion))
+        p0 = np.array([state.x, state.y])
+        radius = spec.radius + self.guard.config.margin
+        dist = 1.5 * spec.v_max
+        for k in range(8):
+            a = state.theta + k * math.pi / 4.0
+            target = p0 + dist * np.array([math.cos(a), math.sin(a)])
+            if not obstacles.segment_free(p0, target, radius):
+                continue
+            tr = polyline_trajectory(np.array([p0, target]), spec, state, t, obstacles, radius)
+            if tr.certified_free:
+                cands.append(("evade", tr))
+            if abs(state.v) > 1e-3:
+                tr = plan_motion(np.array([p0, target]), spec, state, obstacles, t,
+                                 allow_turn=False)
+                if tr.certified_free and tr.feasible:
+                    cands.append(("evade", tr))
+        if current is not None and t < float(current.t_end) - 1e-9:
+            cands.append(("keep", current))
+        return cands
+
+
+def best_fallback(ranker: FallbackRanker, t: float, state: RobotState,
+                  full: Sequence[PredictedObstacle], planned: Sequence[PredictedObstacle],
+                  motion: Any = None, current: Any = None,
+                  reach: Sequence[PredictedObstacle] = ()) -> tuple[str, Any, float]:
+    """``(kind, trajectory, clearance [m])`` of the best of :meth:`FallbackRanker.candidates`
+    by :meth:`FallbackRanker.rank` (the first on a tie: keeping ``current`` is taken only when
+    strictly better)."""
+    ranked = [(ranker.rank(tr, t, full, planned, reach), kind, tr)
+              for kind, tr in ranker.candidates(t, state, full, motion, current)]
+    (_, clear), kind, tr = max(ranked, key=lambda c: c[0][0])
+    return kind, tr, clear
