@@ -265,3 +265,15 @@ def test_passive_safety_refuses_speed_an_obstacle_could_cut_into():
     assert guard.check(motion, far, 0.0, 0.3, reach=reach_far)[0] != "unsafe"
     hold = guard.fallback(0.0, RobotState(1.0, 4.0, 0.0, 0.0, 0.0), []).trajectory
     assert guard.check(hold, away, 0.0, 0.0, reach=reach)[0] != "unsafe"
+
+
+def test_reachable_disc_of_a_standing_obstacle_grows_at_the_floor_speed():
+    from anyplan.agents.safety import reachable_discs
+
+    standing = [PredictedObstacle("S", 0.25, UnicycleMotion(3.0, 4.0, 0.0, 0.0, 0.0))]
+    p, h = np.array([1.0, 4.0]), 5.0
+    (d,) = reachable_discs(standing, 0.0, p, 0.0, 0.3, h)
+    assert float(d.radius_at(1.0)) == pytest.approx(0.25 + 0.3)
+    (d,) = reachable_discs(standing, 0.0, p, 0.0, 0.3, h, min_speed=1.6)
+    assert float(d.radius_at(1.0)) == pytest.approx(0.25 + 1.6)
+    assert float(d.radius_at(10.0)) == pytest.approx(0.25 + 1.6 * h)  # held after the horizon

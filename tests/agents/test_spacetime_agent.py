@@ -180,6 +180,8 @@ def test_guard_option():
         make_agent("st-bitstar", passive_safety="yes")
     with pytest.raises(ValueError, match="reach_extra_mps"):
         make_agent("st-bitstar", reach_extra_mps=-0.1)
+    with pytest.raises(ValueError, match="reach_min_speed_mps"):
+        make_agent("st-bitstar", reach_min_speed_mps=-1.0)
     with pytest.raises(ValueError, match="guard"):
         make_agent("st-bitstar", guard="sometimes")
 

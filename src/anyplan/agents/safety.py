@@ -361,11 +361,13 @@ class SafetyGuard:
 
 
 def reachable_discs(preds: Sequence[PredictedObstacle], t: float, p: np.ndarray, heading: float,
-                    extra_speed: float, horizon_s: float) -> list[PredictedObstacle]:
+                    extra_speed: float, horizon_s: float, min_speed: float = 0.0
+                    ) -> list[PredictedObstacle]:
     """Discs [m] that contain, from ``t`` [s] on, every position an obstacle of ``preds`` can
-    reach whatever it does, if its speed stays within its predicted speed plus ``extra_speed``
-    [m/s]: centred where it is predicted at ``t``, with its radius there, growing at that speed
-    up to ``horizon_s`` [s] (then held). Only obstacles not behind the robot at ``p``, heading
+    reach whatever it does, if its speed stays within ``max(its predicted speed +
+    extra_speed, min_speed)`` [m/s] (``min_speed``: e.g. a person standing still can set off
+    at walking speed): centred where it is predicted at ``t``, with its radius there, growing
+    at that speed up to ``horizon_s`` [s] (then held). Only obstacles not behind the robot at ``p``, heading
     ``heading`` [rad], are kept: one behind it meets a robot moving away (or at rest), which is
     not the robot driving into it.
     """
@@ -377,7 +379,7 @@ def reachable_discs(preds: Sequence[PredictedObstacle], t: float, p: np.ndarray,
         q = o.positions(np.array([t]))[0]
         if float(np.dot(q - p, u)) < 0.0:
             continue
-        speed = float(o.max_speed) + extra_speed
+        speed = max(float(o.max_speed) + extra_speed, min_speed)
         growth = RadiusGrowth(t, np.array([0.0, horizon_s]), np.array([0.0, speed * horizon_s]))
         out.append(PredictedObstacle(o.name, float(o.radius_at(t)),
                                      UnicycleMotion(float(q[0]), float(q[1]), 0.0, 0.0), growth))

@@ -137,6 +137,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             one driving into it. The robot slows down near obstacles it cannot predict.
         reach_extra_mps: Speed [m/s] added to each obstacle's predicted speed for its
             reachable disc.
+        reach_min_speed_mps: Least speed [m/s] of a reachable disc's growth, whatever the
+            prediction (a person standing still can set off; ISO/TS 15066 assumes 1.6 m/s
+            for a walking person). 0: the predicted speed + ``reach_extra_mps`` only.
         **kwargs: Further options of :class:`SequentialBITStarAgent` (planning_delay, ...).
     """
 
@@ -149,6 +152,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                  horizon_s: float | None = 3.0, plan_extra_m: float | None = 0.3,
                  guard: str = "growth", manoeuvre_accel: float = 0.0,
                  passive_safety: bool = False, reach_extra_mps: float = 0.3,
+                 reach_min_speed_mps: float = 0.0,
                  **kwargs: Any) -> None:
         loop = {k: kwargs.pop(k) for k in list(kwargs) if k in _LOOP_FIELDS}  # e.g. from --set
         if config is None:
@@ -175,6 +179,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         if not (isinstance(reach_extra_mps, int | float) and reach_extra_mps >= 0.0):
             raise ValueError(f"reach_extra_mps: must be >= 0, got {reach_extra_mps!r}")
         self.reach_extra_mps = float(reach_extra_mps)
+        if not (isinstance(reach_min_speed_mps, int | float) and reach_min_speed_mps >= 0.0):
+            raise ValueError(f"reach_min_speed_mps: must be >= 0, got {reach_min_speed_mps!r}")
+        self.reach_min_speed_mps = float(reach_min_speed_mps)
         if plan_extra_m is not None and not (isinstance(plan_extra_m, int | float)
                                              and plan_extra_m >= 0.0):
             raise ValueError(f"plan_extra_m: must be >= 0 or null, got {plan_extra_m!r}")
@@ -367,7 +374,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             return []
         h = self.guard.config.horizon_s
         return reachable_discs(self._unknown, t, np.array([state.x, state.y]), state.theta,
-                               self.reach_extra_mps, h)
+                               self.reach_extra_mps, h, self.reach_min_speed_mps)
 
     def _evasions(self, t: float, state: RobotState, safe: list[PredictedObstacle],
                   motion: Trajectory | None, current: Trajectory | None = None,
