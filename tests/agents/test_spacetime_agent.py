@@ -396,3 +396,27 @@ def test_fallback_struck_at_rest_beats_one_struck_later_driving_into_it():
     k_drive, _ = agent._fallback_rank(drive, 0.0, west, west)
     assert k_hold > k_drive
     assert k_hold[:4] == k_drive[:4]  # tied on everything before the approach speed
+
+
+def test_when_no_fallback_is_passively_safe_the_one_at_rest_soonest_ranks_first():
+    # A standing person 1.2 m ahead of a robot at 1 m/s, reachable at 1.6 m/s: no escape is at
+    # rest before the person could reach it. Braking now (at rest in 1 s) outranks driving on
+    # (its escape follows the motion one check period first, then brakes).
+    from anyplan.agents.safety import reachable_discs
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.world import RobotState, UnicycleMotion
+
+    agent = _agent_in_empty_room(v_max=1.0, omega_max=1.0, a_max=1.0, alpha_max=2.0)
+    state = RobotState(3.0, 3.0, 0.0, 1.0, 0.0)
+    person = [PredictedObstacle("P", 0.25, UnicycleMotion(4.2, 3.0, 0.0, 0.0))]
+    reach = reachable_discs(person, 0.0, np.array([3.0, 3.0]), 0.0, 0.3, 5.0, min_speed=1.6)
+    brake = next(tr for kind, tr, _ in agent.guard.candidates(0.0, state, person) if kind == "brake")
+    from anyplan.trajectory.motion import plan_motion
+
+    drive = plan_motion(np.array([[3.0, 3.0], [6.0, 3.0]]), agent.spec, state, agent.obstacles,
+                        0.0, allow_turn=False)
+    assert drive.state(0.5).v > 0.9
+    k_brake, _ = agent._fallback_rank(brake, 0.0, person, person, reach)
+    k_drive, _ = agent._fallback_rank(drive, 0.0, person, person, reach)
+    assert k_brake[1][0] is False and k_drive[1][0] is False  # neither passively safe
+    assert k_brake[1] > k_drive[1]

@@ -88,7 +88,8 @@ class FallbackRanker:
 
         Best first: clear of the static obstacles (braking straight ahead beside a wall may
         not be); passively safe against ``reach`` (only when given:
-        :func:`~anyplan.agents.safety.reachable_discs`); free over the horizon against the
+        :func:`~anyplan.agents.safety.reachable_discs`; among those that are not, the one
+        whose escape is at rest soonest); free over the horizon against the
         full discs; then free over it against the ``planned`` (capped) discs; then, when the
         planned discs strike it, met at rest or moving away rather than driving into the
         obstacle (:func:`approach_speed`); then the latest first contact against the planned
@@ -101,11 +102,13 @@ class FallbackRanker:
         cfg = guard.config
         h = max(t + cfg.horizon_s, float(tr.t_end), t)
         r = self.spec.radius
-        passive = True
+        passive: tuple[bool, float] = (True, 0.0)
         if reach:
             esc = Escape(tr, t + self.commit_s, self.spec, self.obstacles, r)
-            passive = first_collision(esc, reach, r, t_from=t, t_until=max(esc.t_rest, t),
-                                      margin=cfg.margin, sample_dt=cfg.sample_dt) is None
+            ok = first_collision(esc, reach, r, t_from=t, t_until=max(esc.t_rest, t),
+                                 margin=cfg.margin, sample_dt=cfg.sample_dt) is None
+            # none passively safe: the one at rest soonest (the least exposure while moving)
+            passive = (ok, 0.0 if ok else -round(esc.t_rest - t, 2))
         clear = guard.clearance(tr, full, t, h)
         hit = first_collision(tr, planned, r, t_from=t, t_until=h, margin=cfg.margin,
                               sample_dt=cfg.sample_dt)
