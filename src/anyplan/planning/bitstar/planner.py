@@ -254,10 +254,12 @@ class BITStar(Planner):
                 gc.enable()
 
     def _solve(self, ptc: TerminationCondition | float) -> PlannerStatus:
-        ptc = as_condition(ptc).bind(self)
-        obs = self._obs.arrays
+        # The solve clock starts before the condition is bound (a time budget starts there),
+        # so that a search stopped by its budget reports at least the budget as its time.
         t0 = time.perf_counter()
         clock_base = self._solve_time - t0
+        ptc = as_condition(ptc).bind(self)
+        obs = self._obs.arrays
         if self.n_batches == 0 and not math.isfinite(self.best_cost):
             self._try_direct_edge(clock_base)
         cfg = self.config
