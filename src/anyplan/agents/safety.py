@@ -188,15 +188,13 @@ class SafetyGuard:
         m = self.config.margin if margin is None else margin
         t_end = max(float(motion.t_end), t)
         hit = self._hit(motion, preds, t, t_end, m)
-        esc = None
-        if reach:
-            esc = Escape(motion, t + commit_s, self.spec, self.obstacles, self.spec.radius)
-            if self._hit(esc, reach, t, esc.t_rest, m) is not None:
-                return "unsafe", esc.t_commit, esc.t_rest, None if hit is None else hit.t
+        if hit is None and not reach:
+            return "free_to_rest", None, t_end, None
+        esc = Escape(motion, t + commit_s, self.spec, self.obstacles, self.spec.radius)
+        if reach and self._hit(esc, reach, t, esc.t_rest, m) is not None:
+            return "unsafe", esc.t_commit, esc.t_rest, None if hit is None else hit.t
         if hit is None:
             return "free_to_rest", None, t_end, None
-        if esc is None:
-            esc = Escape(motion, t + commit_s, self.spec, self.obstacles, self.spec.radius)
         if esc.static_free and self._hit(esc, preds, t, esc.t_rest, m) is None:
             return "stoppable", esc.t_commit, esc.t_rest, hit.t
         return "unsafe", esc.t_commit, esc.t_rest, hit.t
@@ -367,9 +365,9 @@ def reachable_discs(preds: Sequence[PredictedObstacle], t: float, p: np.ndarray,
     reach whatever it does, if its speed stays within ``max(its predicted speed +
     extra_speed, min_speed)`` [m/s] (``min_speed``: e.g. a person standing still can set off
     at walking speed): centred where it is predicted at ``t``, with its radius there, growing
-    at that speed up to ``horizon_s`` [s] (then held). Only obstacles not behind the robot at ``p``, heading
-    ``heading`` [rad], are kept: one behind it meets a robot moving away (or at rest), which is
-    not the robot driving into it.
+    at that speed up to ``horizon_s`` [s] (then held). Only obstacles not behind the robot at
+    ``p``, heading ``heading`` [rad], are kept: one behind it meets a robot moving away (or at
+    rest), which is not the robot driving into it.
     """
     u = np.array([math.cos(heading), math.sin(heading)])
     out = []

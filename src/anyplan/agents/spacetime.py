@@ -206,8 +206,6 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         self._rows: RowCache | None = None
         #: Nominal motions of this replanning and whether each is free as timed (``_timed_fn``).
         self._nominals: dict[tuple[Any, ...], tuple[Trajectory, bool | None, list[Shape]]] = {}
-        #: The predictions of unknown futures (a horizon, no announced motion) last observed.
-        self._unknown: list[PredictedObstacle] = []
 
     def _new_record(self) -> SpaceTimeStats:
         return SpaceTimeStats()
@@ -350,14 +348,17 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 for o in preds]
 
     def _guard(self, obs: Observation, t_switch: float, motion: Trajectory | None,
-               safe: list[PredictedObstacle], reason: str) -> tuple[str, Trajectory | None]:
+               safe: list[PredictedObstacle], observed: list[PredictedObstacle],
+               reason: str) -> tuple[str, Trajectory | None]:
         """The safety invariant against the full uncertain predictions ``safe``: start
         ``motion`` at ``t_switch`` [s] if it is free to rest or stoppable there, else keep the
-        current motion if it still is, else the guard's fallback of largest predicted clearance
-        (hold, brake, turn away, back off). Returns the decision's kind and trajectory."""
+        current motion if it still is, else the best of :meth:`_evasions`. With
+        ``passive_safety``, both must also be passively safe against the reachable discs of
+        the ``observed`` predictions (:meth:`_reach`). Returns the decision's kind and
+        trajectory."""
         commit = self.check_period_s + max(t_switch - obs.t, 0.0)
         state = self._state_at(obs, t_switch)
-        reach = self._reach(t_switch, state)
+        reach = self._reach(observed, t_switch, state)
         dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit, reach)
         if dec.kind in ("motion", "keep"):
             return dec.kind, dec.trajectory
@@ -367,14 +368,16 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
              "predicted_clearance_m": _finite(clear)})
         return kind, tr
 
-    def _reach(self, t: float, state: RobotState) -> list[PredictedObstacle]:
-        """The reachable discs at ``t`` [s] of the obstacles whose future is unknown
-        (``passive_safety``; empty when it is off or every motion is announced)."""
-        if not self.passive_safety or not self._unknown:
+    def _reach(self, observed: list[PredictedObstacle], t: float,
+               state: RobotState) -> list[PredictedObstacle]:
+        """The reachable discs at ``t`` [s] of the ``observed`` predictions whose future is
+        unknown (a horizon, no announced motion), with ``passive_safety``; else none."""
+        unknown = [o for o in observed if o.until < math.inf] if self.passive_safety else []
+        if not unknown:
             return []
-        h = self.guard.config.horizon_s
-        return reachable_discs(self._unknown, t, np.array([state.x, state.y]), state.theta,
-                               self.reach_extra_mps, h, self.reach_min_speed_mps)
+        return reachable_discs(unknown, t, np.array([state.x, state.y]), state.theta,
+                               self.reach_extra_mps, self.guard.config.horizon_s,
+                               self.reach_min_speed_mps)
 
     def _evasions(self, t: float, state: RobotState, safe: list[PredictedObstacle],
                   motion: Trajectory | None, current: Trajectory | None = None,
@@ -422,7 +425,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
         dt, d, t_ready, state = self._begin_replan(obs)
         t = obs.t
-        self._unknown = [o for o in preds if o.until < math.inf]
+        observed = preds
         preds, safe = self._split(preds, np.array([state.x, state.y]), t_ready)
         uncertain = safe is not None
         self._cands = []
@@ -467,9 +470,10 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         # really have, on the same path (no new search).
         t_switch, motion = self._take_up(obs, t_ready, wall, d, dt, motion,
                                          lambda state, t_s: self._retime_path(state, t_s, path, shapes))
-        if (safe is not None and self._guarded_by(safe)) or (self.passive_safety and self._unknown):
+        if (safe is not None and self._guarded_by(safe)) or (
+                self.passive_safety and any(o.until < math.inf for o in observed)):
             kind, motion = self._guard(obs, t_switch, motion, preds if safe is None else safe,
-                                       res.status)
+                                       observed, res.status)
             if kind == "keep":
                 return
             if kind != "motion":
@@ -533,9 +537,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             return
         # ``_replan`` is given the predictions as observed (``preds``): it splits them itself,
         # so that its guard checks the full discs, not the capped ones planned against.
-        self._unknown = [o for o in preds if o.until < math.inf]
         planned, safe = self._split(preds, np.array([obs.robot.x, obs.robot.y]), t)
-        reach = self._reach(t, obs.robot)
+        reach = self._reach(preds, t, obs.robot)
         if ((safe is not None and self._guarded_by(safe)) or reach) and not self.guard.still_safe(
                 traj, planned if safe is None else safe, t, self.check_period_s + 0.1, reach):
             self._replan(obs, preds, "safety: the motion in use can no longer stop in time")
