@@ -277,3 +277,15 @@ def test_reachable_disc_of_a_standing_obstacle_grows_at_the_floor_speed():
     (d,) = reachable_discs(standing, 0.0, p, 0.0, 0.3, h, min_speed=1.6)
     assert float(d.radius_at(1.0)) == pytest.approx(0.25 + 1.6)
     assert float(d.radius_at(10.0)) == pytest.approx(0.25 + 1.6 * h)  # held after the horizon
+
+
+def test_decide_without_fallback_says_unsafe_and_logs_nothing():
+    # The same near disc as above: the guard would brake; asked for no fallback, it returns
+    # "unsafe" without a trajectory and logs no fallback.
+    guard = SafetyGuard(SPEC, ROOM)
+    state, motion = _cruising()
+    d = guard.decide(0.0, motion, None, state, [_parked_disc("near", 1.9, 4.0)], 0.3,
+                     fallback=False)
+    assert (d.kind, d.trajectory, d.safe) == ("unsafe", None, False)
+    assert d.reason.startswith("proposed motion: collision predicted")
+    assert guard.fallbacks == [] and guard.decisions == []

@@ -210,9 +210,9 @@ def test_guard_of_a_safety_replanning_checks_the_full_discs():
     seen = []
     decide = agent.guard.decide
 
-    def spy(t_s, motion, current, state, preds, commit, reach=()):
+    def spy(t_s, motion, current, state, preds, commit, reach=(), fallback=True):
         seen.append(list(preds))
-        return decide(t_s, motion, current, state, preds, commit, reach)
+        return decide(t_s, motion, current, state, preds, commit, reach, fallback)
 
     agent.guard.decide = spy
     agent._check(Observation(t, st), [ahead])

@@ -105,7 +105,9 @@ class Decision:
 
     Attributes:
         t: Time [s] the chosen trajectory starts.
-        kind: ``"motion"``, ``"keep"`` or a fallback kind (:data:`FALLBACK_KINDS`).
+        kind: ``"motion"``, ``"keep"``, a fallback kind (:data:`FALLBACK_KINDS`), or
+            ``"unsafe"`` (neither passes, and ``decide(fallback=False)`` asked for no
+            fallback).
         trajectory: What the robot executes from ``t``.
         safe: True when ``trajectory`` satisfies the rule from ``t`` (free to rest, or stoppable);
             for a fallback, when its moving part is predicted collision-free.
@@ -211,7 +213,7 @@ class SafetyGuard:
     # --- decisions ---------------------------------------------------------------------------
     def decide(self, t: float, motion: Any, current: Any, state: RobotState,
                preds: Sequence[PredictedObstacle], commit_s: float,
-               reach: Sequence[PredictedObstacle] = ()) -> Decision:
+               reach: Sequence[PredictedObstacle] = (), fallback: bool = True) -> Decision:
         """Start ``motion``, keep ``current``, or fall back (see the module docstring).
 
         Args:
@@ -223,6 +225,9 @@ class SafetyGuard:
             commit_s: Time [s] before the agent can act again.
             reach: Reachable discs a started or kept motion must be passively safe against
                 (:meth:`check`); the fallbacks are ranked against ``preds``.
+            fallback: False: when neither passes, return an ``"unsafe"`` decision without a
+                trajectory (for a caller that chooses its own fallback) instead of the
+                guard's fallback.
         """
         reason = "no motion proposed"
         if motion is not None and not getattr(motion, "feasible", True):
@@ -240,6 +245,8 @@ class SafetyGuard:
             rule, tc, tr, fc = self.check(current, preds, t, commit_s, reach=reach)
             if rule != "unsafe":
                 return self._log(Decision(t, "keep", current, True, rule, tc, tr, fc))
+        if not fallback:
+            return Decision(t, "unsafe", None, False, "unsafe", reason=reason)
         return self._log(self.fallback(t, state, preds, reason))
 
     def _log(self, d: Decision) -> Decision:

@@ -359,7 +359,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         commit = self.check_period_s + max(t_switch - obs.t, 0.0)
         state = self._state_at(obs, t_switch)
         reach = self._reach(observed, t_switch, state)
-        dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit, reach)
+        # the guard's own fallback is not asked for: _evasions ranks its candidates with more
+        dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit, reach,
+                                fallback=False)
         if dec.kind in ("motion", "keep"):
             return dec.kind, dec.trajectory
         kind, tr, clear = self._evasions(t_switch, state, safe, motion, self.trajectory, reach)
