@@ -10,6 +10,12 @@ in fresh processes:
 * warm: the same command again ``--repeats`` times with that cache: seconds from the process's
   spawn to the agent's first planning call, and the phases before it.
 
+On a cold cache the command hands the motion kernels to a second process
+(``anyplan.agents.warmup.prefetch_kernels``); the phase tables count this process's compilations
+only, and the command's own line ("compiled N functions in S s, M of them in a second process")
+gives the whole. ``--serial`` adds one more cold run with ``ANYPLAN_COMPILE_JOBS=1`` (everything
+compiled in one process), for the comparison.
+
 CPU seconds are the process's own (``time.process_time``): on this shared 2-core machine the
 wall clock is inflated by the load (printed), the CPU time much less. Usage::
 
@@ -81,22 +87,30 @@ json.dump(dict(code=code, marks=marks, compiles=rows), open(OUT + "/startup.json
 """
 
 
-def run_once(cache: str) -> dict:
-    """One ``anyplan run paper-3`` in a fresh process with numba's cache in ``cache``."""
+def run_once(cache: str, jobs: str | None = None) -> dict:
+    """One ``anyplan run paper-3`` in a fresh process with numba's cache in ``cache`` (and
+    ``ANYPLAN_COMPILE_JOBS=jobs`` if given); adds the command's compile line and wall time."""
     out = tempfile.mkdtemp(prefix="startup-")
     env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+    if jobs is not None:
+        env["ANYPLAN_COMPILE_JOBS"] = jobs
     spawn = time.time()
-    subprocess.run([sys.executable, "-c", CHILD, repr(spawn), out], env=env, check=True,
-                   stdout=subprocess.DEVNULL)
+    proc = subprocess.run([sys.executable, "-c", CHILD, repr(spawn), out], env=env, check=True,
+                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    wall = time.time() - spawn
     with open(os.path.join(out, "startup.json")) as f:
-        return json.load(f)
+        res = json.load(f)
+    res["line"] = next((ln for ln in proc.stderr.splitlines() if "compiled" in ln), "")
+    res["wall"] = wall
+    return res
 
 
 def compile_report(res: dict, top: int) -> None:
     """Compile seconds: total, by phase, and the costliest kernels."""
     rows = res["compiles"]
     cpu = sum(r["cpu"] for r in rows)
-    print(f"cold: {len(rows)} functions compiled, {cpu:.1f} s CPU, {sum(r['wall'] for r in rows):.1f} s wall")
+    wall = sum(r["wall"] for r in rows)
+    print(f"this process: {len(rows)} functions compiled, {cpu:.1f} s CPU, {wall:.1f} s wall")
     by_phase: dict[str, list[float]] = {}
     for r in rows:
         by_phase.setdefault(r["phase"], [0.0, 0.0, 0])
@@ -131,10 +145,17 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeats", type=int, default=3, help="warm runs (default 3)")
     ap.add_argument("--top", type=int, default=20, help="kernels listed (default 20)")
+    ap.add_argument("--serial", action="store_true",
+                    help="also one cold run compiling in one process (ANYPLAN_COMPILE_JOBS=1)")
     args = ap.parse_args()
     print("load:", os.getloadavg())
     cache = tempfile.mkdtemp(prefix="numba-cache-")
     cold = run_once(cache)
+    print(f"cold: {cold['line'] or 'nothing compiled'}; whole command {cold['wall']:.1f} s wall")
+    if args.serial:
+        serial = run_once(tempfile.mkdtemp(prefix="numba-cache-"), jobs="1")
+        print(f"cold, ANYPLAN_COMPILE_JOBS=1: {serial['line']}; whole command "
+              f"{serial['wall']:.1f} s wall")
     compile_report(cold, args.top)
     marks_table([cold])
     warm = [run_once(cache) for _ in range(args.repeats)]

@@ -77,6 +77,7 @@ def test_run_says_compiling_when_anything_in_the_command_compiles(tmp_path, caps
         return int(fresh(1)) - 2
 
     monkeypatch.setattr(cmd_run, "_run", run_that_compiles)
+    monkeypatch.setenv("ANYPLAN_COMPILE_JOBS", "1")  # no second process for this stand-in
     assert main(["run", "paper-1", "--out", str(tmp_path)]) == 0
     err = capsys.readouterr().err
     assert "compiling kernels" in err and "compiled 1 function in" in err
@@ -96,3 +97,79 @@ def test_first_run_on_a_fresh_cache_says_compiling_and_the_second_does_not(tmp_p
     assert first.returncode == second.returncode == 1  # straight collides on paper-1
     assert "compiling kernels" in first.stderr and "functions in" in first.stderr
     assert "compil" not in second.stderr
+
+
+@pytest.fixture
+def no_parts_loaded(monkeypatch):
+    """This process has loaded no part and started no second process (restored afterwards)."""
+    import anyplan.agents.warmup as wu
+
+    monkeypatch.setattr(wu, "_DONE", set())
+    monkeypatch.setattr(wu, "_PREFETCH", {})
+    return wu
+
+
+def test_second_process_takes_the_motion_part_only_when_another_part_stays_here(no_parts_loaded):
+    wu = no_parts_loaded
+    assert wu.prefetch_parts(PARTS) == ("motion",)
+    assert wu.prefetch_parts(("bitstar", "motion")) == ("motion",)
+    assert wu.prefetch_parts(("motion",)) == ()  # this process would only wait
+    assert wu.prefetch_parts(("bitstar",)) == ()
+    wu._DONE.add("motion")
+    assert wu.prefetch_parts(PARTS) == ()  # already loaded here
+
+
+def test_one_compile_job_starts_no_second_process(no_parts_loaded, monkeypatch):
+    wu = no_parts_loaded
+    monkeypatch.setenv("ANYPLAN_COMPILE_JOBS", "1")
+    assert wu.prefetch_kernels(PARTS) == ()
+    assert wu._PREFETCH == {}
+
+
+def test_a_failed_second_process_is_reported_as_such_and_counts_nothing(no_parts_loaded):
+    job = no_parts_loaded._Prefetch(("nope",))  # its warm_up_kernels refuses the part
+    job.finish(timeout_s=300)
+    assert job.ok is False and job.count == 0 and job.seconds == 0.0
+    job.finish()  # a second call waits no more
+    assert job.ok is False
+
+
+def test_run_counts_the_second_process_in_its_compile_message(tmp_path, capsys, monkeypatch):
+    import anyplan.cli.cmd_run as cmd_run
+
+    @njit
+    def fresh2(x):
+        return x + 2
+
+    monkeypatch.setattr(cmd_run, "_run", lambda args: int(fresh2(1)) - 3)
+    monkeypatch.setenv("ANYPLAN_COMPILE_JOBS", "1")
+    import anyplan.agents.warmup as wu
+
+    monkeypatch.setattr(wu, "prefetch_report", lambda: (40, 2.5))
+    assert main(["run", "paper-1", "--out", str(tmp_path)]) == 0
+    err = capsys.readouterr().err
+    assert "compiled 41 functions in" in err and "40 of them in a second process" in err
+    secs = float(err.split("compiled 41 functions in ")[1].split(" s")[0])
+    assert secs >= 2.5  # the wait for the second process is compile time on this clock
+
+
+@pytest.mark.slow
+def test_second_process_fills_the_cache_that_this_process_then_loads(no_parts_loaded, tmp_path,
+                                                                     monkeypatch):
+    import os
+    import subprocess
+    import sys
+
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(cache))
+    monkeypatch.delenv("ANYPLAN_COMPILE_JOBS", raising=False)
+    job = no_parts_loaded._Prefetch(("motion",))
+    job.finish(timeout_s=600)
+    assert job.ok and job.count > 10 and job.seconds > 0.0
+    assert any(f.suffix == ".nbc" for f in cache.rglob("*"))
+    probe = ("from anyplan.agents.warmup import compiling_notifier, warm_up_kernels\n"
+             "with compiling_notifier(None) as n: warm_up_kernels(['motion'])\n"
+             "print(n.count)")
+    out = subprocess.run([sys.executable, "-c", probe], env=dict(os.environ), capture_output=True,
+                         text=True, timeout=600, check=True)
+    assert out.stdout.strip() == "0"  # everything loaded from the cache the second process wrote

@@ -7,24 +7,42 @@ BIT*'s search; ``"motion"``: smoothing, speed profile and sampling; ``"sequentia
 prediction and one replanning around a crossing obstacle), so that neither cost lands inside a
 timed planning call: loading a planner's code is a start-up cost, not part of a replanning.
 ``on_compile`` is called once, when numba really compiles (a cache miss), so a command can say
-"compiling" only when it is. ``docs/motion.md``, "Compiled kernels".
+"compiling" only when it is.
+
+numba compiles under the interpreter's lock, one function at a time, so a thread cannot share the
+work; a second *process* can. :func:`prefetch_kernels` starts one that compiles a part into the
+on-disk cache while this process compiles the others; :func:`warm_up_kernels` waits for it
+before that part and then loads the part from the cache. ``docs/motion.md``, "Compiled kernels".
 """
 
 from __future__ import annotations
 
+import atexit
+import json
 import logging
+import os
+import subprocess
+import sys
+import tempfile
 import time
 from collections.abc import Callable, Iterable, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-__all__ = ["warm_up_kernels", "PARTS", "compiling_notifier"]
+__all__ = ["warm_up_kernels", "PARTS", "compiling_notifier", "prefetch_kernels", "prefetch_parts",
+           "prefetch_report"]
 
 logger = logging.getLogger(__name__)
 #: Every part, in the order they are loaded.
 PARTS = ("bitstar", "motion", "sequential")
 _DONE: set[str] = set()
+#: A part that a second process may compile while this one compiles the others: it shares no
+#: kernel with loading a scenario, the time lower bound or BIT*'s part (``sequential`` runs
+#: BIT* and the motion planner, so it would compile both again).
+PREFETCHABLE = ("motion",)
+#: Set to ``1`` (or ``0``) to compile in this process only.
+ENV_JOBS = "ANYPLAN_COMPILE_JOBS"
 
 
 class compiling_notifier:  # noqa: N801 - a context manager used like a function
@@ -75,6 +93,118 @@ class compiling_notifier:  # noqa: N801 - a context manager used like a function
         from numba.core import event
 
         event.unregister("numba:compile", self._listener)
+
+
+class _Prefetch:
+    """A second process compiling ``parts`` into numba's on-disk cache."""
+
+    def __init__(self, parts: tuple[str, ...]) -> None:
+        import anyplan
+
+        self.parts = parts
+        self.log = tempfile.TemporaryFile(mode="w+")  # noqa: SIM115 - closed in finish()
+        root = os.path.dirname(os.path.dirname(os.path.abspath(anyplan.__file__)))
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
+        env[ENV_JOBS] = "1"
+        self.t0 = time.perf_counter()
+        self.proc = subprocess.Popen(
+            [sys.executable, "-c", "import sys; from anyplan.agents.warmup import _child; _child()",
+             *parts], stdin=subprocess.DEVNULL, stdout=self.log, stderr=subprocess.STDOUT, env=env)
+        self.waited_s = 0.0
+        self.count = 0
+        self.seconds = 0.0
+        self.ok: bool | None = None
+
+    def finish(self, timeout_s: float = 600.0) -> None:
+        """Wait for the process (at most ``timeout_s``, then stop it); read what it compiled."""
+        if self.ok is not None:
+            return
+        t0 = time.perf_counter()
+        try:
+            code = self.proc.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            code = self.proc.wait()
+        self.waited_s = time.perf_counter() - t0
+        self.log.seek(0)
+        out = self.log.read()
+        self.log.close()
+        self.ok = code == 0
+        last = out.strip().splitlines()[-1:] if out.strip() else []
+        try:
+            rec = json.loads(last[0]) if self.ok and last else {}
+        except ValueError:
+            rec = {}
+        self.count, self.seconds = int(rec.get("count", 0)), float(rec.get("seconds", 0.0))
+        if not self.ok:
+            logger.info("compiling %s in a second process failed (exit %s); compiling here:\n%s",
+                        ", ".join(self.parts), code, out[-2000:])
+
+    def stop(self) -> None:
+        if self.ok is None and self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait()
+            self.ok = False
+            self.log.close()
+
+
+_PREFETCH: dict[str, _Prefetch] = {}
+
+
+def prefetch_parts(parts: Iterable[str]) -> tuple[str, ...]:
+    """The parts of ``parts`` that :func:`prefetch_kernels` would hand to a second process: the
+    prefetchable ones, when another part stays for this process and this process has not
+    loaded them yet."""
+    parts = tuple(parts)
+    mine = [p for p in parts if p not in PREFETCHABLE]
+    return tuple(p for p in parts if p in PREFETCHABLE and p not in _DONE and p not in _PREFETCH
+                 and mine)
+
+
+def prefetch_kernels(parts: Iterable[str]) -> tuple[str, ...]:
+    """Start compiling the prefetchable ``parts`` (:func:`prefetch_parts`) in a second process;
+    returns the parts handed over (none on a single core, or with ``ANYPLAN_COMPILE_JOBS=1``).
+
+    Call it when numba starts compiling (a cold cache: :class:`compiling_notifier`'s callback):
+    this process goes on with scenario loading and the other parts, and :func:`warm_up_kernels`
+    waits for the second process before a part it took, then loads that part from the cache.
+    On a warm cache there is nothing to gain (loading takes milliseconds), so do not call it.
+    If the second process fails, this one compiles the part itself."""
+    jobs = os.environ.get(ENV_JOBS, "").strip()
+    if jobs in ("0", "1") or (not jobs and (os.cpu_count() or 1) < 2):
+        return ()
+    todo = prefetch_parts(parts)
+    if not todo:
+        return ()
+    try:
+        job = _Prefetch(todo)
+    except OSError as exc:  # no process could be started: compile here
+        logger.info("no second process for compiling: %s", exc)
+        return ()
+    for p in todo:
+        _PREFETCH[p] = job
+    return todo
+
+
+def prefetch_report() -> tuple[int, float]:
+    """Functions compiled by the second processes that have finished, and the seconds [s] this
+    process waited for them (compile time on its clock, beside its own compilations)."""
+    jobs = {id(j): j for j in _PREFETCH.values() if j.ok is not None}.values()
+    return sum(j.count for j in jobs), sum(j.waited_s for j in jobs)
+
+
+@atexit.register
+def _stop_prefetch() -> None:
+    for job in _PREFETCH.values():
+        job.stop()
+
+
+def _child() -> None:
+    """The second process: compile ``sys.argv[1:]``, print what it compiled as one JSON line."""
+    with compiling_notifier(None) as note:
+        warm_up_kernels(sys.argv[1:])
+    print(json.dumps({"count": note.count, "seconds": note.seconds}))
 
 
 def _bitstar() -> None:
@@ -159,6 +289,9 @@ def warm_up_kernels(parts: Iterable[str] = PARTS,
     with compiling_notifier(on_compile) as note:
         for p in todo:
             _DONE.add(p)
+            job = _PREFETCH.get(p)
+            if job is not None:
+                job.finish()  # then the part loads from the cache it filled
             _RUN[p]()
     dt = time.perf_counter() - t0
     logger.info("kernels %s %s in %.2f s", "compiled" if note.compiled else "loaded",

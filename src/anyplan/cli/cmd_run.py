@@ -66,16 +66,37 @@ def cmd_scenarios(args: argparse.Namespace) -> int:
 
 def cmd_run(args: argparse.Namespace) -> int:
     """Simulate one run and write its result and picture; say so on stderr if numba compiles
-    kernels (the first run on a machine), and for how long."""
-    from anyplan.agents.warmup import compiling_notifier
+    kernels (the first run on a machine), and for how long.
 
-    with compiling_notifier(_compiling_notice) as note:
+    On a cold cache a second process compiles the planner's motion kernels meanwhile
+    (:func:`~anyplan.agents.warmup.prefetch_kernels`; ``ANYPLAN_COMPILE_JOBS=1`` turns it off)."""
+    from anyplan.agents.warmup import compiling_notifier, prefetch_kernels, prefetch_report
+
+    def compiling() -> None:
+        _compiling_notice()
+        prefetch_kernels(_kernel_parts(args.planner))
+
+    with compiling_notifier(compiling) as note:
         code = _run(args)
     if note.compiled:
-        what = f"{note.count} function" + ("s" if note.count != 1 else "")
-        sys.stderr.write(f"anyplan: compiled {what} in {note.seconds:.1f} s "
+        more, waited = prefetch_report()
+        n = note.count + more
+        what = f"{n} function" + ("s" if n != 1 else "")
+        where = f", {more} of them in a second process" if more else ""
+        sys.stderr.write(f"anyplan: compiled {what} in {note.seconds + waited:.1f} s{where} "
                          "(once: later runs load them from the cache)\n")
     return code
+
+
+def _kernel_parts(planner: str) -> tuple[str, ...]:
+    """The compiled parts the planner loads (``Agent.kernel_parts``), none if it is unknown."""
+    from anyplan.agents.base import AGENTS
+
+    try:
+        cls = AGENTS.get(planner)
+    except Exception:  # noqa: BLE001 - an unknown or broken planner fails later, with its message
+        return ()
+    return tuple(getattr(cls, "kernel_parts", ()))
 
 
 def _compiling_notice() -> None:
