@@ -12,7 +12,7 @@ import pytest
 from anyplan.agents import AGENTS, make_agent
 from anyplan.experiments.gaps import WALL_T, WALL_X, gap_world, issue_gap_scenario
 from anyplan.planning.sequential import SequentialConfig
-from anyplan.simulation import simulate
+from anyplan.simulation import SimConfig, simulate
 from anyplan.world.scenario import scenario_from_dict
 from tests.conftest import fast_at_a_wall_dict
 
@@ -102,6 +102,7 @@ def test_result_fields():
     assert len(ex["st_waits_s"]) == len(d["plans"]) and all(w >= 0.0 for w in ex["st_waits_s"])
     assert 0 <= ex["st_timed"] <= len(d["plans"])
     assert len(ex["st_candidates"]) == len(d["planning_times_s"])
+    assert isinstance(ex["st_pruned"], int) and ex["st_pruned"] >= 0
     assert all(p["arrival_s"] >= p["t_start"] for p in d["plans"])
     # re-timed ("st+..."), or a plan_motion kind when the untimed motion was already free
     assert all(p["kind"].startswith("st+") or p["kind"] in ("smooth", "turn+smooth",
@@ -420,3 +421,46 @@ def test_when_no_fallback_is_passively_safe_the_one_at_rest_soonest_ranks_first(
     k_drive, _ = agent._fallback_rank(drive, 0.0, person, person, reach)
     assert k_brake[1][0] is False and k_drive[1][0] is False  # neither passively safe
     assert k_brake[1] > k_drive[1]
+
+
+@pytest.mark.skipif(not _DYNABARN.is_file(), reason="shared DynaBARN worlds.json not present")
+def test_branch_and_bound_prunes_paths_that_cannot_arrive_earlier(monkeypatch):
+    # DynaBARN 40-47, motions announced, the first replanning only. With the bound, the shortest
+    # path is timed with long waits first and a detour whose untimed motion arrives no earlier
+    # than the best timed candidate ends the loop; each pruned path could only have been timed
+    # later than the candidate chosen, and the choice arrives no later than the full search's.
+    import anyplan.agents.spacetime as st
+    from anyplan.experiments.dynabarn import load_worlds, world_to_scenario
+    from anyplan.simulation.perception import override_sensing
+
+    pruned: list[tuple[float, float]] = []  # (untimed arrival of the pruned path, best arrival)
+    inner = st.SpaceTimeBITStarAgent._timed_fn
+
+    def spy(self, state, t_start, max_wait_s, **kw):
+        build = inner(self, state, t_start, max_wait_s, **kw)
+
+        def wrapped(path, shapes, delay):
+            n = self.record.st_pruned
+            out = build(path, shapes, delay)
+            if self.record.st_pruned > n:
+                nominal = self._nominals[next(reversed(self._nominals))][0]
+                pruned.append((nominal.t_end, min(c[0] for c in self._cands)))
+                assert out is min(self._cands, key=lambda c: c[0])[1]
+            return out
+        return wrapped
+
+    monkeypatch.setattr(st.SpaceTimeBITStarAgent, "_timed_fn", spy)
+    worlds = {w["world"]: w for w in load_worlds(_DYNABARN)}
+    cfg = SimConfig(time_limit=0.05)
+    settings = AGENTS.get("st-bitstar").deterministic_settings
+    for i in range(40, 48):
+        sc = override_sensing(scenario_from_dict(world_to_scenario(worlds[i])), "oracle")
+        first = []
+        for bound in (True, False):
+            agent = make_agent("st-bitstar", **settings)
+            agent.branch_and_bound = bound
+            simulate(sc, agent, seed=0, config=cfg)
+            first.append(agent.stats.plans[0]["arrival_s"] if agent.stats.plans else math.inf)
+        assert first[0] <= first[1] + 1e-9, i
+    assert pruned, "no world pruned a path"
+    assert all(nominal >= best - 1e-9 for nominal, best in pruned)

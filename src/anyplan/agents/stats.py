@@ -120,6 +120,8 @@ class SpaceTimeStats(SequentialStats):
         st_waits_s: Planned wait [s] of each motion started.
         st_timed: Motions started that were re-timed among the moving obstacles.
         st_candidates: Timed candidates per replanning.
+        st_pruned: Loop paths left untimed because their untimed motion arrives no earlier than
+            a timed candidate (each ends its replanning's search).
         inside_discs: Predicted discs that already held the robot when it planned, shrunk to
             let it leave (uncertain predictions only; left out when None).
     """
@@ -127,12 +129,13 @@ class SpaceTimeStats(SequentialStats):
     KEYS: ClassVar[tuple[str, ...]] = (
         "statuses", "iterations", "late_plans", "plan_time_s", "motion_time_s", "replan_times_s",
         "waits", "fallbacks", "safety_time_s", "st_waits_s", "st_timed", "st_candidates",
-        "inside_discs", "reasons", "progress", "safety", "tracking", *_TRACKING)
+        "st_pruned", "inside_discs", "reasons", "progress", "safety", "tracking", *_TRACKING)
     OPTIONAL: ClassVar[frozenset[str]] = SequentialStats.OPTIONAL | {"inside_discs"}
 
     st_waits_s: list[float] = field(default_factory=list)
     st_timed: int = 0
     st_candidates: list[int] = field(default_factory=list)
+    st_pruned: int = 0
     inside_discs: int | None = None
 
 
