@@ -1,6 +1,7 @@
 """CPU time per planning call of st-bitstar, and its decisions, for two source trees back-to-back.
 
-Runs st-bitstar deterministically (``planning_delay=0.1, batches_per_plan=2, max_time_s=10``) on
+Runs st-bitstar deterministically (its ``deterministic_settings``: ``planning_delay=0.1,
+batches_per_plan=2, max_time_s=10``, no search budget) on
 paper-1..3 (``--seeds`` seeds), the first ``--random`` scenarios of ``random_suite(0)``,
 ``gap_suite(0, n=--gaps)`` and ``--dynabarn`` of DynaBARN's medium and hard worlds (20-59, evenly
 spread; tracks announced, as in ``benchmarks/spacetime.py``), and records for every run its
@@ -76,7 +77,9 @@ def worker(args: argparse.Namespace) -> dict[str, Any]:
     def agent() -> Any:
         if args.mode == "bench":  # benchmarks/spacetime.py's settings: BIT* on a time budget
             return make_agent("st-bitstar", planning_delay=0.1)
-        return make_agent("st-bitstar", planning_delay=0.1, batches_per_plan=2, max_time_s=10)
+        from anyplan.agents import AGENTS
+
+        return make_agent("st-bitstar", **AGENTS.get("st-bitstar").deterministic_settings)
 
     scen = _scenarios(args)
     simulate(scen[0][1], agent(), seed=0)  # warm-up: compiled kernels loaded, caches filled

@@ -42,8 +42,9 @@ def _head_on_gap():
 
 
 def _fixed():
-    return {"planning_delay": 0.1, "config": SequentialConfig(max_iterations=8, wait_delays_s=(),
-                                                            batches_per_plan=2, max_time_s=10.0)}
+    return {"planning_delay": 0.1, "search_budget_s": None,
+            "config": SequentialConfig(max_iterations=8, wait_delays_s=(), batches_per_plan=2,
+                                       max_time_s=10.0)}
 
 
 def test_registered():
@@ -112,6 +113,11 @@ def test_result_fields():
 def test_bad_options():
     with pytest.raises(ValueError, match="patience_s"):
         make_agent("st-bitstar", patience_s=0.0)
+    for bad in (0.0, -1.0, "fast"):
+        with pytest.raises(ValueError, match="search_budget_s"):
+            make_agent("st-bitstar", search_budget_s=bad)
+    assert make_agent("st-bitstar", search_budget_s=None).search_budget_s is None
+    assert AGENTS.get("st-bitstar").deterministic_settings["search_budget_s"] is None
 
 
 @pytest.mark.slow
@@ -464,3 +470,26 @@ def test_branch_and_bound_prunes_paths_that_cannot_arrive_earlier(monkeypatch):
         assert first[0] <= first[1] + 1e-9, i
     assert pruned, "no world pruned a path"
     assert all(nominal >= best - 1e-9 for nominal, best in pruned)
+
+
+@pytest.mark.skipif(not _DYNABARN.is_file(), reason="shared DynaBARN worlds.json not present")
+def test_search_budget_takes_the_best_candidate_once_one_is_timed():
+    # DynaBARN 28 (motions announced): with no time left once a path is timed, the first
+    # replanning stops at its first candidate, which it takes (verified free); the full search
+    # times more paths (three there) and arrives no later.
+    from anyplan.experiments.dynabarn import load_worlds, world_to_scenario
+    from anyplan.simulation.perception import override_sensing
+
+    world = next(w for w in load_worlds(_DYNABARN) if w["world"] == 28)
+    sc = override_sensing(scenario_from_dict(world_to_scenario(world)), "oracle")
+    cfg = SimConfig(time_limit=0.05)
+    settings = dict(AGENTS.get("st-bitstar").deterministic_settings)
+    full = make_agent("st-bitstar", **settings)
+    simulate(sc, full, seed=0, config=cfg)
+    settings["search_budget_s"] = 1e-9
+    quick = make_agent("st-bitstar", **settings)
+    simulate(sc, quick, seed=0, config=cfg)
+    assert quick.record.st_pruned >= 1 and quick.record.st_candidates[0] == 1
+    assert full.record.st_candidates[0] > quick.record.st_candidates[0]
+    assert full.stats.plans[0]["arrival_s"] <= quick.stats.plans[0]["arrival_s"] + 1e-9
+    assert quick.stats.plans[0]["kind"] != "fallback-hold"

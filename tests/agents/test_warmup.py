@@ -34,7 +34,8 @@ def test_unknown_part_is_refused():
 
 
 def test_agents_declare_only_the_parts_they_use():
-    assert make_agent("seq-bitstar").kernel_parts == PARTS
+    assert make_agent("st-bitstar").kernel_parts == PARTS
+    assert make_agent("seq-bitstar").kernel_parts == ("bitstar", "motion", "sequential")
     assert make_agent("bitstar").kernel_parts == ("bitstar", "motion")
     assert not getattr(make_agent("dovs"), "kernel_parts", ())
 

@@ -44,7 +44,6 @@ __all__ = ["SpaceTimeBITStarAgent"]
 _DEFAULT_LOOP = SequentialConfig(max_iterations=8, wait_delays_s=(), max_time_s=0.3, anchor="obstacle",
                                  prove_blocked=True)
 _LOOP_FIELDS = frozenset(f.name for f in dataclasses.fields(SequentialConfig))
-_WARM = False
 #: How far ahead [s] a motion in use is checked (a hold lasts "for ever").
 _CHECK_HORIZON_S = 60.0
 #: Row duration [s] of the s-t maps.
@@ -62,28 +61,6 @@ def _followable(tr: Any) -> bool:
     (``feasible``) without cutting a static or virtual obstacle (``certified_free``): only
     then is a prediction along ``tr`` one about where the robot goes."""
     return bool(getattr(tr, "feasible", True)) and bool(getattr(tr, "certified_free", True))
-
-
-def warm_up_spacetime() -> None:
-    """Load the s-t kernels once per process (outside any timed planning call)."""
-    global _WARM
-    if _WARM:
-        return
-    _WARM = True
-    from anyplan.geometry.collision import ObstacleSet
-    from anyplan.planning.connectivity import provably_disconnected
-    from anyplan.trajectory.motion import plan_motion
-    from anyplan.world.motion import UnicycleMotion
-    from anyplan.world.robot import RobotSpec
-
-    spec = RobotSpec(start=(0.5, 0.5, 0.0), goal=(3.5, 0.5), radius=0.2)
-    obs = ObstacleSet([], bounds=(0.0, 0.0, 4.0, 2.0))
-    tr = plan_motion(np.array([[0.5, 0.5], [3.5, 0.5]]), spec, RobotState(0.5, 0.5, 0.0), obs, 0.0)
-    mover = PredictedObstacle("X", 0.2, UnicycleMotion(2.0, 1.9, -1.5708, 0.3))
-    res = retime(tr, [mover], spec, max_wait_s=5.0)
-    if res.trajectory is not None:
-        verify(res.trajectory, [mover], spec.radius)
-    provably_disconnected(obs, (0.5, 0.5), (3.5, 0.5), spec.radius)  # the detours' proof
 
 
 def _remaining(path: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -116,6 +93,10 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             searched by branch and bound (:meth:`_timed_fn`). When no path can be timed, the
             last path (with uncertain predictions, the first and the last) is timed again with
             waits up to this, and the earlier arrival wins.
+        search_budget_s: Anytime bound of the search for detours [s]: once a path is timed, a
+            replanning that has run this long (wall clock) takes the best candidate instead of
+            timing more detours (with certain predictions; None: no budget, as the
+            deterministic settings have it). Without a timed path the loop runs on.
         lattice_dt_s: Approximate step [s] of the velocity lattice.
         horizon_s: Horizon [s] of a prediction extrapolated from the current twist (perception
             ``twist`` or ``tracked``: no announced motion); beyond it the obstacle is not checked
@@ -147,9 +128,12 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
     """
 
     name = "st-bitstar"
+    kernel_parts = ("bitstar", "motion", "sequential", "spacetime")
     #: Search the loop's candidate paths by branch and bound (:meth:`_timed_fn`) when the
     #: predictions are certain; False times every path of the loop within ``patience_s``.
     branch_and_bound = True
+    deterministic_settings = {**SequentialBITStarAgent.deterministic_settings,  # noqa: RUF012
+                              "search_budget_s": None}
     config_classes = (_DEFAULT_LOOP,)  # its defaults, for the listing of settings
     record: SpaceTimeStats
 
@@ -158,7 +142,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                  horizon_s: float | None = 3.0, plan_extra_m: float | None = 0.3,
                  guard: str = "growth", manoeuvre_accel: float = 0.0,
                  passive_safety: bool = False, reach_extra_mps: float = 0.3,
-                 reach_min_speed_mps: float = 0.0,
+                 reach_min_speed_mps: float = 0.0, search_budget_s: float | None = 0.03,
                  **kwargs: Any) -> None:
         loop = {k: kwargs.pop(k) for k in list(kwargs) if k in _LOOP_FIELDS}  # e.g. from --set
         if config is None:
@@ -195,13 +179,17 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         if not (isinstance(accept_s, int | float) and 0.0 <= accept_s <= patience_s):
             raise ValueError(f"accept_s: must be in [0, patience_s], got {accept_s!r}")
         self.accept_s = float(accept_s)
+        if search_budget_s is not None and not (isinstance(search_budget_s, int | float)
+                                                and search_budget_s > 0.0):
+            raise ValueError(f"search_budget_s: must be > 0 or null, got {search_budget_s!r}")
+        self.search_budget_s = None if search_budget_s is None else float(search_budget_s)
+        self._search_deadline: float | None = None
         self.patience_s = float(patience_s)
         self.max_wait_s = float(max_wait_s)
         self.lattice_dt_s = float(lattice_dt_s)
 
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
-        warm_up_spacetime()
-        super().reset(scenario, rng)
+        super().reset(scenario, rng)  # loads the kernel parts, "spacetime" among them
         self.predictor = ConstantTwistPredictor(horizon_s=self.horizon_s,
                                                 manoeuvre_accel=self.manoeuvre_accel)
         self._cands: list[tuple[float, Trajectory, np.ndarray, list[Shape]]] = []
@@ -233,6 +221,11 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             self._rows = RowCache(t_start, _ROW_H)  # the obstacles' s-t rows, for every candidate
 
         def build(path: np.ndarray, shapes: Sequence[Shape], delay: float) -> Trajectory:
+            if (first_wait_s is not None and shapes and delay == 0.0 and self._cands
+                    and self._search_deadline is not None
+                    and time.perf_counter() > self._search_deadline):
+                self.record.st_pruned += 1
+                return min(self._cands, key=lambda c: c[0])[1]  # anytime: the best so far
             if delay == 0.0:
                 self._tried.append((np.asarray(path), list(shapes)))
             # The same path, squares and start again (the long waits on a path already tried):
@@ -459,6 +452,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         self._rows = None
         self._nominals = {}
         w0 = time.perf_counter()
+        self._search_deadline = None if self.search_budget_s is None else w0 + self.search_budget_s
         res: SequentialResult | None = None
         if self._path is not None and len(self._path) >= 2:
             # First the path in use, from where the robot will be: no new search if it can be

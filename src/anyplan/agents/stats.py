@@ -121,7 +121,8 @@ class SpaceTimeStats(SequentialStats):
         st_timed: Motions started that were re-timed among the moving obstacles.
         st_candidates: Timed candidates per replanning.
         st_pruned: Loop paths left untimed because their untimed motion arrives no earlier than
-            a timed candidate (each ends its replanning's search).
+            a timed candidate, or because the search budget had run out once a candidate was
+            timed (each ends its replanning's search).
         inside_discs: Predicted discs that already held the robot when it planned, shrunk to
             let it leave (uncertain predictions only; left out when None).
     """

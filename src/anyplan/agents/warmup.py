@@ -4,10 +4,11 @@ anyplan's hot loops are numba functions compiled on first use and cached on disk
 (``cache=True``): the first process on a machine compiles them, later ones load the cached
 code. Agents call :func:`warm_up_kernels` in ``reset`` with the parts they use (``"bitstar"``:
 BIT*'s search; ``"motion"``: smoothing, speed profile and sampling; ``"sequential"``: collision
-prediction and one replanning around a crossing obstacle), so that neither cost lands inside a
-timed planning call: loading a planner's code is a start-up cost, not part of a replanning.
-``on_compile`` is called once, when numba really compiles (a cache miss), so a command can say
-"compiling" only when it is.
+prediction and one replanning around a crossing obstacle; ``"spacetime"``: the s-t map, the
+velocity lattice, the certified re-check and the detours' disconnection proof of st-bitstar),
+so that neither cost lands inside a timed planning call: loading a planner's code is a start-up
+cost, not part of a replanning. ``on_compile`` is called once, when numba really compiles (a
+cache miss), so a command can say "compiling" only when it is.
 
 numba compiles under the interpreter's lock, one function at a time, so a thread cannot share the
 work; a second *process* can. :func:`prefetch_kernels` starts one that compiles a part into the
@@ -35,7 +36,7 @@ __all__ = ["warm_up_kernels", "PARTS", "compiling_notifier", "prefetch_kernels",
 
 logger = logging.getLogger(__name__)
 #: Every part, in the order they are loaded.
-PARTS = ("bitstar", "motion", "sequential")
+PARTS = ("bitstar", "motion", "sequential", "spacetime")
 _DONE: set[str] = set()
 #: A part that a second process may compile while this one compiles the others: it shares no
 #: kernel with loading a scenario, the time lower bound or BIT*'s part (``sequential`` runs
@@ -268,7 +269,26 @@ def _sequential() -> None:
     loop.replan(np.array([0.5, 3.0]), np.array([3.5, 0.5]), [crossing], 0.0)
 
 
-_RUN = {"bitstar": _bitstar, "motion": _motion, "sequential": _sequential}
+def _spacetime() -> None:
+    from anyplan.geometry.collision import ObstacleSet
+    from anyplan.planning.connectivity import provably_disconnected
+    from anyplan.prediction.base import PredictedObstacle
+    from anyplan.trajectory.motion import plan_motion
+    from anyplan.trajectory.spacetime import retime, verify
+    from anyplan.world.motion import UnicycleMotion
+    from anyplan.world.robot import RobotSpec, RobotState
+
+    spec = RobotSpec(start=(0.5, 0.5, 0.0), goal=(3.5, 0.5), radius=0.2)
+    obs = ObstacleSet([], bounds=(0.0, 0.0, 4.0, 2.0))
+    tr = plan_motion(np.array([[0.5, 0.5], [3.5, 0.5]]), spec, RobotState(0.5, 0.5, 0.0), obs, 0.0)
+    mover = PredictedObstacle("X", 0.2, UnicycleMotion(2.0, 1.9, -1.5708, 0.3))
+    res = retime(tr, [mover], spec, max_wait_s=5.0)
+    if res.trajectory is not None:
+        verify(res.trajectory, [mover], spec.radius)
+    provably_disconnected(obs, (0.5, 0.5), (3.5, 0.5), spec.radius)  # the detours' proof
+
+
+_RUN = {"bitstar": _bitstar, "motion": _motion, "sequential": _sequential, "spacetime": _spacetime}
 
 
 def warm_up_kernels(parts: Iterable[str] = PARTS,
