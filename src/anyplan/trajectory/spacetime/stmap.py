@@ -124,9 +124,12 @@ class RowCache:
         same = st is not None and len(st[0]) == len(obstacles) and all(
             x is y for x, y in zip(st[0], obstacles, strict=True))
         if st is None or not same or not (st[1] <= j0 and j1 <= st[2]):
-            a, b = j0, j1
+            # From the grid's origin (the replanning's start: maps start a few rows apart, after
+            # a turn in place or a brake) and with rows to spare (longer paths, longer waits):
+            # every regrowth stacks all the obstacles again.
+            a, b = min(j0, 0), j1 + _SPARE_ROWS
             if st is not None and same:
-                a, b = min(st[1], j0), max(st[2], j1)
+                a, b = min(st[1], a), max(st[2], b)
             parts = [self.rows(o, a, b) for o in obstacles]
             # the rows each obstacle's entry holds (rows to spare included) bound the stack
             lo = max(self._rows[id(o)][1] for o in obstacles)
