@@ -313,3 +313,56 @@ def test_start_bounds_of_tracks_of_every_length_at_once_are_the_per_length_ones(
             assert np.isfinite(got).any() and (got == -np.inf).any()
             assert np.array_equal(collision._start_bounds(sub, fa, grid, gc, pc, m.max_speed, 0.35),
                                   want)  # from the cache
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_straight_start_bounds_are_lower_bounds_and_change_no_answer(seed, monkeypatch):
+    # Twist and tracked predictions (straight lines, growing discs, a horizon): the bounds of
+    # _start_bounds never pass an uncertified fine interval, and the first contact found with
+    # them is the one found with no bounds at all.
+    from anyplan.prediction import collision
+    from anyplan.prediction.base import RadiusGrowth
+
+    rng = np.random.default_rng(100 + seed)
+    obs = []
+    for i in range(60):
+        x0, y0, th, v = rng.uniform((0, 0, -np.pi, 0.0), (15, 11, np.pi, 1.5))
+        if i % 4 == 0:  # crossing the robot's route, met or just missed
+            x0, y0, th = rng.uniform(2.0, 13.0), 5.0 - 3.0 * np.sign(i % 8 - 3.5), np.pi / 2
+            th *= np.sign(5.0 - y0)
+        t0 = float(rng.uniform(0.0, 2.0))
+        g = (RadiusGrowth(t0, np.array([0.0, 3.0]), np.array([0.05, 0.05 + 0.4 * rng.uniform()]))
+             if i % 2 else None)
+        until = float(rng.uniform(3.0, 8.0)) if i % 3 == 0 else np.inf
+        obs.append(PredictedObstacle(f"p{i}", 0.25, UnicycleMotion(x0, y0, th, v, 0.0, t0), g,
+                                     until))
+    found = 0
+    for m in MOTIONS.values():
+        for sd in (None, 0.02):
+            collision._MEMO.clear()
+            lazy = first_collision(m, obs, 0.3, margin=0.05, sample_dt=sd)
+            monkeypatch.setattr(collision, "_straight_bounds", lambda *a: None)
+            collision._MEMO.clear()
+            plain = first_collision(m, obs, 0.3, margin=0.05, sample_dt=sd)
+            monkeypatch.undo()
+            assert _same(lazy, plain)
+            found += lazy is not None
+        grid = np.linspace(m.t_start, m.t_end, 401)
+        gc = grid[::16]
+        p = m.positions(grid)
+        reach0 = 0.35
+        bounds = collision._start_bounds(obs, np.zeros(len(obs), dtype=bool), grid, gc,
+                                         m.positions(gc), m.max_speed, reach0)
+        assert np.isfinite(bounds).any() and np.isposinf(bounds).any()
+        for o, b in zip(obs, bounds, strict=True):
+            # the fine certificate of _predict_uncached, brute force on every fine interval
+            d = np.hypot(*(p - o.positions(grid)).T)
+            rate = 0.0
+            if o.growth is not None:
+                d = d - o.growth.at(grid)
+                rate = o.growth.rate
+            low = 0.5 * (d[:-1] + d[1:] - (m.max_speed + o.max_speed + rate) * np.diff(grid))
+            bad = np.flatnonzero(low <= reach0 + o.radius)
+            if len(bad):
+                assert b <= grid[bad[0]], o.name
+    assert found > 0

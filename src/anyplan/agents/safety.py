@@ -160,6 +160,7 @@ class SafetyGuard:
         self.config = config or SafetyConfig()
         self.decisions: list[Decision] = []
         self.fallbacks: list[dict[str, Any]] = []
+        self._tracks_memo: tuple[tuple[Any, ...], np.ndarray, _Tracks] | None = None
 
     # --- checks ------------------------------------------------------------------------------
     def _hit(self, motion: Any, preds: Sequence[PredictedObstacle], t0: float, t1: float,
@@ -275,16 +276,19 @@ class SafetyGuard:
         # minimum (an upper bound on its own) cannot be the nearest: it is not searched.
         ts = np.linspace(t0, t1, max(2, int(math.ceil((t1 - t0) / 0.1)) + 1))
         pm = motion.positions(ts)
-        bounds = []
-        for o in preds:
-            t1o = min(t1, float(getattr(o, "until", math.inf)))
-            if t1o < t0:
-                bounds.append((math.inf, math.inf))
-                continue
-            d = np.hypot(*(pm - o.positions(ts)).T) - _max_radius(o) - r
-            d[ts > t1o + 0.1] = math.inf
-            lb = 0.5 * (d[:-1] + d[1:] - (float(motion.max_speed) + float(o.max_speed)) * np.diff(ts))
-            bounds.append((float(lb.min()), float(d.min())))
+        bounds: list[tuple[float, float]] = []
+        if preds:
+            # every obstacle at once, element by element the operations of one at a time
+            q, ro_max, vo, until = self._tracks_at(preds, ts)
+            d = np.hypot(pm[None, :, 0] - q[:, :, 0], pm[None, :, 1] - q[:, :, 1]) \
+                - ro_max[:, None] - r
+            d[ts[None, :] > np.minimum(t1, until)[:, None] + 0.1] = math.inf
+            lbs = 0.5 * (d[:, :-1] + d[:, 1:]
+                         - (float(motion.max_speed) + vo)[:, None] * np.diff(ts)[None, :])
+            gone = np.minimum(t1, until) < t0
+            lows = np.where(gone, math.inf, lbs.min(axis=1))
+            dm = np.where(gone, math.inf, d.min(axis=1))
+            bounds = list(zip(lows.tolist(), dm.tolist(), strict=True))
         cutoff = min((b[1] for b in bounds), default=math.inf)
         for o, (lo, _) in zip(preds, bounds, strict=True):
             if lo > cutoff + 1e-6:
@@ -302,6 +306,24 @@ class SafetyGuard:
                                     tol=self.config.tol)
             best = min(best, d - r - ro)
         return best
+
+    def _tracks_at(self, preds: Sequence[PredictedObstacle], ts: np.ndarray) -> _Tracks:
+        """Every prediction's centres (n, len(ts), 2) [m] at ``ts``, largest radii, speed
+        bounds [m/s] and horizons [s]. The last answer is kept: the candidates of one fallback
+        ranking ask for the same predictions on the same grid (the entry holds the predictions,
+        so an ``id`` seen here is the same live object)."""
+        memo = self._tracks_memo
+        if memo is not None and len(memo[0]) == len(preds) and memo[1].shape == ts.shape \
+                and np.array_equal(memo[1], ts) and all(
+                    a is b for a, b in zip(memo[0], preds, strict=True)):
+            return memo[2]
+        q = np.stack([np.asarray(o.positions(ts), dtype=float) for o in preds])
+        ro = np.array([_max_radius(o) for o in preds])
+        vo = np.array([float(o.max_speed) for o in preds])
+        until = np.array([float(getattr(o, "until", math.inf)) for o in preds])
+        out = (q, ro, vo, until)
+        self._tracks_memo = (tuple(preds), ts.copy(), out)
+        return out
 
     def candidates(self, t: float, state: RobotState,
                    preds: Sequence[PredictedObstacle]) -> list[tuple[str, Trajectory, float]]:
@@ -389,6 +411,10 @@ def reachable_discs(preds: Sequence[PredictedObstacle], t: float, p: np.ndarray,
         out.append(PredictedObstacle(o.name, float(o.radius_at(t)),
                                      UnicycleMotion(float(q[0]), float(q[1]), 0.0, 0.0), growth))
     return out
+
+
+#: Predictions on a time grid: centres (n, T, 2), largest radii, speed bounds, horizons.
+_Tracks = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 def _max_radius(o: Any) -> float:

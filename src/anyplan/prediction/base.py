@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
@@ -28,6 +28,7 @@ class RadiusGrowth:
     t0: float
     taus: np.ndarray
     values: np.ndarray
+    _rate: float = field(init=False, repr=False, compare=False, default=0.0)
 
     def __post_init__(self) -> None:
         k = np.asarray(self.taus, dtype=float)
@@ -36,6 +37,8 @@ class RadiusGrowth:
             raise ValueError("taus must be increasing and as long as values")
         object.__setattr__(self, "taus", k)
         object.__setattr__(self, "values", v)
+        rate = 0.0 if len(k) < 2 else float(max(np.max(np.diff(v) / np.diff(k)), 0.0))
+        object.__setattr__(self, "_rate", rate)  # asked for in every contact search
 
     def at(self, t: np.ndarray | float) -> np.ndarray:
         """Extra radius [m] at absolute times ``t`` [s]."""
@@ -44,9 +47,7 @@ class RadiusGrowth:
     @property
     def rate(self) -> float:
         """Upper bound on d extra / dt [m/s]."""
-        if len(self.taus) < 2:
-            return 0.0
-        return float(max(np.max(np.diff(self.values) / np.diff(self.taus)), 0.0))
+        return self._rate
 
     @property
     def max_extra(self) -> float:
