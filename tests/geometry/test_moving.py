@@ -86,3 +86,54 @@ def test_plateau_terminates_and_stays_conservative():
     assert first_contact(robot, m.positions, 0.5, 1.0 + 1e-9, 0.0, 20.0) == 0.0
     _, d = closest_approach(robot, m.positions, 0.5, 0.0, 20.0, tol=1e-6)
     assert abs(d - 1.0) < 1e-9
+
+
+def _closest_one_by_one(pos_a, pos_b, rel_speed_bound, t0, t1, tol=1e-6):
+    """closest_approach evaluating interval by interval (its former loop): the reference."""
+    L = max(rel_speed_bound, 1e-12)
+
+    def dist(t):
+        d = pos_a(t) - pos_b(t)
+        return np.hypot(d[:, 0], d[:, 1])
+
+    ts = np.linspace(t0, t1, 129)
+    fs = dist(ts)
+    i = int(np.argmin(fs))
+    best_t, best = float(ts[i]), float(fs[i])
+    intervals = [(ts[j], ts[j + 1], fs[j], fs[j + 1]) for j in range(128)]
+    evals = 129
+    while intervals and evals < MAX_EVALUATIONS:
+        nxt = []
+        for a, b, fa, fb in intervals:
+            if 0.5 * (fa + fb - L * (b - a)) >= best - L * tol or b - a <= tol:
+                continue
+            mids = np.linspace(a, b, 5)
+            fm = dist(mids[1:-1])
+            evals += 3
+            j = int(np.argmin(fm))
+            if fm[j] < best:
+                best, best_t = float(fm[j]), float(mids[1 + j])
+            vals = np.concatenate([[fa], fm, [fb]])
+            nxt.extend((mids[m], mids[m + 1], vals[m], vals[m + 1]) for m in range(4))
+        intervals = nxt
+    return best_t, best
+
+
+@settings(max_examples=60, deadline=None)
+@given(x0=f, y0=f, th=st.floats(-3.2, 3.2), v=st.floats(0.05, 1.5), om=st.floats(-0.8, 0.8),
+       mid=st.floats(3.0, 7.0), t0=st.floats(0.0, 5.0), span=st.floats(0.5, 12.0))
+def test_closest_approach_batched_levels_answer_as_one_by_one(x0, y0, th, v, om, mid, t0, span):
+    # Each refinement level is evaluated in one call: the same time and distance, bit for bit,
+    # as evaluating every interval on its own, along a planned (spline) motion.
+    from anyplan.geometry import ObstacleSet
+    from anyplan.trajectory.motion import plan_motion
+    from anyplan.world import RobotSpec, RobotState
+
+    spec = RobotSpec(start=(1.0, 5.0, 0.0), goal=(14.0, 5.0))
+    robot = plan_motion(np.array([[1.0, 5.0], [7.5, mid], [14.0, 5.0]]), spec,
+                        RobotState(1.0, 5.0, 0.0), ObstacleSet([], bounds=(0.0, 0.0, 15.0, 11.0)),
+                        0.0)
+    m = UnicycleMotion(x0 + 7.0, y0 + 5.0, th, v, om)
+    L = float(robot.max_speed) + v
+    assert closest_approach(robot.positions, m.positions, L, t0, t0 + span) == \
+        _closest_one_by_one(robot.positions, m.positions, L, t0, t0 + span)
