@@ -333,9 +333,8 @@ def _start_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, grid:
     out[far] = math.inf
     if len(gc) < 2:
         return out
-    dt = np.diff(gc)
     half_fine = 0.5 * float(np.diff(grid).max())
-    _straight_bounds(obstacles, far, out, gc, pc, dt, half_fine, vr, reach0)
+    _straight_bounds(obstacles, far, out, gc, pc, half_fine, vr, reach0)
     ks = [k for k, o in enumerate(obstacles)
           if not far[k] and o.growth is None and isinstance(o.motion, WaypointMotion)]
     if not ks:
@@ -349,14 +348,22 @@ def _start_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, grid:
     w = np.clip((tm - a[:, :, 0]) / (b[:, :, 0] - a[:, :, 0]), 0.0, 1.0)
     d = np.hypot(pc[None, :, 0] - (a[:, :, 1] + w * (b[:, :, 1] - a[:, :, 1])),
                  pc[None, :, 1] - (a[:, :, 2] + w * (b[:, :, 2] - a[:, :, 2])))
-    sel = np.array(ks)
     lip = np.array([vr + _track(obstacles[k])[1] for k in ks])
-    need = (reach0 + np.array([obstacles[k].radius for k in ks]) + lip * half_fine
-            + 1e-9 * (1.0 + reach0 + lip))
-    low = 0.5 * (d[:, :-1] + d[:, 1:] - lip[:, None] * dt[None, :]) <= need[:, None]
-    first = np.argmax(low, axis=1)
-    out[sel] = np.where(low.any(axis=1), gc[first], math.inf)
+    out[np.array(ks)] = _first_uncertified(d, lip, np.array([obstacles[k].radius for k in ks]),
+                                           gc, half_fine, reach0)
     return out
+
+
+def _first_uncertified(d: np.ndarray, lip: np.ndarray, radii: np.ndarray, gc: np.ndarray,
+                       half_fine: float, reach0: float) -> np.ndarray:
+    """Per obstacle (a row of gaps ``d`` [m] at the coarse times ``gc``, its gap's Lipschitz
+    bound ``lip`` [m/s] and radius [m]), the start of the first coarse interval whose bound is
+    <= reach + L dt_max / 2 (+ 1e-9 m, far above the gaps' rounding), inf if none: before it
+    no fine interval is uncertified (:func:`_start_bounds`)."""
+    need = reach0 + radii + lip * half_fine + 1e-9 * (1.0 + reach0 + lip)
+    low = 0.5 * (d[:, :-1] + d[:, 1:] - lip[:, None] * np.diff(gc)[None, :]) <= need[:, None]
+    first = np.argmax(low, axis=1)
+    return np.where(low.any(axis=1), gc[first], math.inf)
 
 
 def first_collision(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], robot_radius: float,
@@ -383,7 +390,7 @@ def min_separation(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], 
 
 
 def _straight_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, out: np.ndarray,
-                     gc: np.ndarray, pc: np.ndarray, dt: np.ndarray, half_fine: float, vr: float,
+                     gc: np.ndarray, pc: np.ndarray, half_fine: float, vr: float,
                      reach0: float) -> None:
     """:func:`_start_bounds` for the discs moving on straight lines at constant speed (the
     ``twist`` and ``tracked`` predictions, :class:`UnicycleMotion` with omega = 0), growing or
@@ -414,8 +421,5 @@ def _straight_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, ou
             d[i] -= g.at(gc)
             rate[i] = g.rate
     lip = vr + np.abs(sp) + rate
-    need = (reach0 + np.array([obstacles[k].radius for k in ls]) + lip * half_fine
-            + 1e-9 * (1.0 + reach0 + lip))
-    low = 0.5 * (d[:, :-1] + d[:, 1:] - lip[:, None] * dt[None, :]) <= need[:, None]
-    first = np.argmax(low, axis=1)
-    out[np.array(ls)] = np.where(low.any(axis=1), gc[first], math.inf)
+    out[np.array(ls)] = _first_uncertified(d, lip, np.array([obstacles[k].radius for k in ls]),
+                                           gc, half_fine, reach0)
