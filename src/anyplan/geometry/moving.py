@@ -192,19 +192,23 @@ def closest_approach(pos_a: PositionFn, pos_b: PositionFn, rel_speed_bound: floa
     best_t, best = float(ts[i]), float(fs[i])
     intervals = [(ts[j], ts[j + 1], fs[j], fs[j + 1]) for j in range(n)]
     evals = n + 1
+
+    def settled(a: float, b: float, fa: float, fb: float) -> bool:
+        """The interval cannot hold a distance below the best by more than L tol, or is fine."""
+        return 0.5 * (fa + fb - L * (b - a)) >= best - L * tol or b - a <= tol
+
     while intervals and evals < MAX_EVALUATIONS:
         nxt: list[tuple[float, float, float, float]] = []
         # The level's points in one evaluation (each position function is called once per level,
-        # not once per interval), for the intervals not already pruned by the best at the
-        # level's start; the loop below then takes the same decisions, in the same order, with
-        # the same values as evaluating interval by interval.
-        live = [k for k, (a, b, fa, fb) in enumerate(intervals)
-                if not (0.5 * (fa + fb - L * (b - a)) >= best - L * tol or b - a <= tol)]
+        # not once per interval), for the intervals not settled by the best at the level's
+        # start (the best only decreases); the loop below then takes the same decisions, in the
+        # same order, with the same values as evaluating interval by interval.
+        live = [k for k, iv in enumerate(intervals) if not settled(*iv)]
         grid = {k: np.linspace(intervals[k][0], intervals[k][1], 5) for k in live}
         fall = dist(np.concatenate([grid[k][1:-1] for k in live])) if live else np.empty(0)
         at = {k: 3 * i for i, k in enumerate(live)}
         for k, (a, b, fa, fb) in enumerate(intervals):
-            if 0.5 * (fa + fb - L * (b - a)) >= best - L * tol or b - a <= tol:
+            if settled(a, b, fa, fb):
                 continue
             mids = grid[k]
             fm = fall[at[k]:at[k] + 3]
