@@ -225,7 +225,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                     and self._search_deadline is not None
                     and time.perf_counter() > self._search_deadline):
                 self.record.st_pruned += 1
-                return min(self._cands, key=lambda c: c[0])[1]  # anytime: the best so far
+                return self._best_candidate()[1]  # anytime: the best so far
             if delay == 0.0:
                 self._tried.append((np.asarray(path), list(shapes)))
             # The same path, squares and start again (the long waits on a path already tried):
@@ -242,7 +242,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 if not shapes:
                     wait = first_wait_s
                 elif self._cands and _followable(nominal):
-                    best = min(self._cands, key=lambda c: c[0])
+                    best = self._best_candidate()
                     if nominal.t_end >= best[0] - 1e-9:
                         self.record.st_pruned += 1
                         return best[1]  # free: the loop stops, the earliest candidate wins
@@ -250,7 +250,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             if memo[1] is None and nominal.certified_free and delay == 0.0 and self._preds:
                 memo = (nominal, verify(nominal, self._preds, spec.radius, margin=cfg.margin,
                                         t_until=nominal.t_end) is None, memo[2])
-            self._nominals[key] = memo
+                self._nominals[key] = memo
             free = memo[1]
             if not _followable(nominal):
                 # A best effort that cuts an obstacle, or that the robot cannot take up from its
@@ -280,6 +280,10 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             return tr if res.delay_s <= self.accept_s else nominal
 
         return build
+
+    def _best_candidate(self) -> tuple[float, Trajectory, np.ndarray, list[Shape]]:
+        """The timed candidate of this replanning that arrives first (the first among equals)."""
+        return min(self._cands, key=lambda c: c[0])
 
     def _tail_time(self, tr: Trajectory) -> float:
         """Time [s] the motion spends inside half the goal tolerance at its end (run over)."""
@@ -489,7 +493,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         motion: Trajectory | None = None
         path, shapes = res.path, [v.shape for v in res.virtual_obstacles]
         if self._cands:
-            _, motion, path, shapes = min(self._cands, key=lambda c: c[0])
+            _, motion, path, shapes = self._best_candidate()
         elif res.collision_free and res.motion is not None and _followable(res.motion):
             motion = res.motion  # type: ignore[assignment]
         wall = time.perf_counter() - w0

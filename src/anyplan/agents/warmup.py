@@ -108,9 +108,8 @@ class _Prefetch:
         env = dict(os.environ)
         env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
         env[ENV_JOBS] = "1"
-        self.t0 = time.perf_counter()
         self.proc = subprocess.Popen(
-            [sys.executable, "-c", "import sys; from anyplan.agents.warmup import _child; _child()",
+            [sys.executable, "-c", "from anyplan.agents.warmup import _child; _child()",
              *parts], stdin=subprocess.DEVNULL, stdout=self.log, stderr=subprocess.STDOUT, env=env)
         self.waited_s = 0.0
         self.count = 0
