@@ -377,10 +377,9 @@ def test_fallback_never_brakes_into_a_wall_when_a_curve_clears_it():
     assert clear.min() >= 0.0
 
 
-def test_fallback_struck_at_rest_beats_one_struck_later_driving_into_it():
-    # Every candidate is predicted struck: a hold at (3, 3), struck at rest by an obstacle coming
-    # west at 1 m/s, ranks before a slow drive east into the same obstacle struck later: the
-    # robot would be driving into it (approach 0.2 m/s > 0.05), a robot-caused collision.
+def _struck_pair(agent, x_obstacle: float, x_drive: float):
+    """A hold at (3, 3) and a drive east at 0.2 m/s from (x_drive, 3), an obstacle coming west at
+    1 m/s from (x_obstacle, 3); their first predicted contacts."""
     from anyplan.prediction import PredictedObstacle
     from anyplan.prediction.collision import first_collision
     from anyplan.trajectory.motion import polyline_trajectory
@@ -388,21 +387,46 @@ def test_fallback_struck_at_rest_beats_one_struck_later_driving_into_it():
     from anyplan.trajectory.trajectory import Trajectory
     from anyplan.world import RobotState, UnicycleMotion
 
-    agent = _agent_in_empty_room(v_max=0.2, omega_max=1.0, a_max=1.0, alpha_max=2.0)
-    west = [PredictedObstacle("W", 0.25, UnicycleMotion(12.0, 3.0, math.pi, 1.0))]
+    west = [PredictedObstacle("W", 0.25, UnicycleMotion(x_obstacle, 3.0, math.pi, 1.0))]
     hold = Trajectory([HoldSegment(3.0, 3.0, 0.0, 0.0, 12.0)], kind="hold")
-    drive = polyline_trajectory(np.array([[1.0, 3.0], [7.0, 3.0]]), agent.spec,
-                                RobotState(1.0, 3.0, 0.0, 0.0, 0.0), 0.0, agent.obstacles,
+    drive = polyline_trajectory(np.array([[x_drive, 3.0], [x_drive + 6.0, 3.0]]), agent.spec,
+                                RobotState(x_drive, 3.0, 0.0, 0.0, 0.0), 0.0, agent.obstacles,
                                 agent.spec.radius)
     r, m = agent.spec.radius, agent.guard.config.margin
     h_hold = first_collision(hold, west, r, t_from=0.0, t_until=12.0, margin=m)
     h_drive = first_collision(drive, west, r, t_from=0.0, t_until=drive.t_end, margin=m)
     assert h_hold is not None and h_drive is not None and h_drive.t > h_hold.t
     assert drive.state(h_drive.t).v > 0.15  # driving east, into the obstacle, at contact
+    return west, hold, drive, h_hold, h_drive
+
+
+def test_fallback_struck_at_rest_beats_one_struck_soon_after_driving_into_it():
+    # Every candidate is predicted struck within the time the robot needs to decide again and
+    # stop (react_s): a hold struck at rest ranks before a drive into the same obstacle struck a
+    # little later (approach 0.2 m/s > 0.05: a robot-caused collision).
+    agent = _agent_in_empty_room(v_max=0.2, omega_max=1.0, a_max=1.0, alpha_max=2.0)
+    ranker = agent._ranker()
+    gap = agent.spec.radius + 0.25 + agent.guard.config.margin
+    west, hold, drive, h_hold, h_drive = _struck_pair(agent, 3.0 + gap + 0.3, 2.9)
+    assert h_drive.t < ranker.react_s  # both contacts are near
     k_hold, _ = agent._fallback_rank(hold, 0.0, west, west)
     k_drive, _ = agent._fallback_rank(drive, 0.0, west, west)
     assert k_hold > k_drive
     assert k_hold[:4] == k_drive[:4]  # tied on everything before the approach speed
+
+
+def test_fallback_struck_later_than_the_reaction_time_beats_a_hold_struck_sooner():
+    # The same obstacle, far away: both contacts lie beyond react_s, so at the next decision
+    # the robot can still stop short of the drive's contact; the approach speed at so distant a
+    # contact does not decide, the later contact does (a hold struck sooner is no safer).
+    agent = _agent_in_empty_room(v_max=0.2, omega_max=1.0, a_max=1.0, alpha_max=2.0)
+    ranker = agent._ranker()
+    west, hold, drive, h_hold, h_drive = _struck_pair(agent, 12.0, 1.0)
+    assert h_hold.t > ranker.react_s
+    k_hold, _ = agent._fallback_rank(hold, 0.0, west, west)
+    k_drive, _ = agent._fallback_rank(drive, 0.0, west, west)
+    assert k_drive > k_hold
+    assert k_hold[:5] == k_drive[:5]  # tied up to the contact time
 
 
 def test_when_no_fallback_is_passively_safe_the_one_at_rest_soonest_ranks_first():

@@ -79,6 +79,10 @@ class FallbackRanker:
         self.obstacles = obstacles
         self.guard = guard
         self.commit_s = float(commit_s)
+        #: A predicted contact later than this [s] leaves the robot time to decide again and
+        #: still come to rest before it: one check period on the candidate, braking from top
+        #: speed, and the next decision's own check period (issue 10's invariant).
+        self.react_s = 2.0 * self.commit_s + spec.v_max / max(spec.a_max, 1e-9)
 
     def rank(self, tr: Any, t: float, full: Sequence[PredictedObstacle],
              planned: Sequence[PredictedObstacle], reach: Sequence[PredictedObstacle] = ()
@@ -91,12 +95,15 @@ class FallbackRanker:
         :func:`~anyplan.agents.safety.reachable_discs`; among those that are not, the one
         whose escape is at rest soonest); free over the horizon against the
         full discs; then free over it against the ``planned`` (capped) discs; then, when the
-        planned discs strike it, met at rest or moving away rather than driving into the
-        obstacle (:func:`approach_speed`); then the latest first contact against the planned
-        discs; then the largest clearance against the full discs. A hold the planned discs run
-        into thus loses to a motion they leave free (standing where an obstacle passes is a
-        collision too), and a short drive that stops just before an obstacle arrives does not
-        beat a hold struck later.
+        planned discs strike it within :attr:`react_s`, met at rest or moving away rather than
+        driving into the obstacle (:func:`approach_speed`); then the latest first contact
+        against the planned discs; then the largest clearance against the full discs. A hold
+        the planned discs run into thus loses to a motion they leave free (standing where an
+        obstacle passes is a collision too), a short drive that stops just before an obstacle
+        arrives does not beat a hold struck later, and a hold struck soon does not beat driving
+        on struck later than :attr:`react_s` (at the next decision the robot can still stop
+        short of that contact; the approach speed of so distant a contact says nothing of what
+        the robot will do).
         """
         guard = self.guard
         cfg = guard.config
@@ -112,8 +119,9 @@ class FallbackRanker:
         clear = guard.clearance(tr, full, t, h)
         hit = first_collision(tr, planned, r, t_from=t, t_until=h, margin=cfg.margin,
                               sample_dt=cfg.sample_dt)
+        near = hit is not None and float(hit.t) - t < self.react_s
         return (bool(getattr(tr, "certified_free", True)), passive, clear >= cfg.margin,
-                hit is None, -approach_speed(tr, hit),
+                hit is None, -approach_speed(tr, hit) if near else 0.0,
                 math.inf if hit is None else float(hit.t), clear), clear
 
     def candidates(self, t: float, state: RobotState, safe: Sequence[PredictedObstacle],
