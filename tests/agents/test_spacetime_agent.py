@@ -429,6 +429,56 @@ def test_fallback_struck_later_than_the_reaction_time_beats_a_hold_struck_sooner
     assert k_hold[:5] == k_drive[:5]  # tied up to the contact time
 
 
+def _corridor_ranker(agent, half_width: float):
+    """The agent's fallback ranker in a corridor along x, |y - 3| <= half_width [m], walls 0.5 m
+    thick."""
+    from anyplan.agents.evasion import FallbackRanker
+    from anyplan.geometry import ObstacleSet
+    from anyplan.geometry.shapes import rectangle
+
+    walls = ObstacleSet([rectangle((6.0, 3.0 - half_width - 0.25), (20.0, 0.5)),
+                         rectangle((6.0, 3.0 + half_width + 0.25), (20.0, 0.5))])
+    return FallbackRanker(agent.spec, walls, agent.guard, agent.check_period_s)
+
+
+def test_evasions_stop_short_of_a_wall_instead_of_being_dropped():
+    # A 2 m corridor: driving 1.5 m (v_max x 1.5 s) sideways would go through the wall, so the
+    # sideways evasions end short of it, clear of it, at least MIN_EVADE_M from the start.
+    from anyplan.agents.evasion import MIN_EVADE_M
+    from anyplan.world import RobotState
+
+    agent = _agent_in_empty_room(v_max=1.0, omega_max=1.5, a_max=1.0, alpha_max=3.0)
+    ranker = _corridor_ranker(agent, 1.0)
+    state = RobotState(5.0, 3.0, 0.0, 0.0, 0.0)
+    ends = [tr.state(float(tr.t_end)) for kind, tr in ranker.candidates(0.0, state, [])
+            if kind == "evade"]
+    side = [e for e in ends if abs(e.x - 5.0) < 1e-6 and abs(e.y - 3.0) > 1e-6]
+    assert len(side) == 2  # up and down the corridor's width, both kept
+    for e in side:
+        d = abs(e.y - 3.0)
+        assert MIN_EVADE_M <= d < 1.5 * agent.spec.v_max
+        assert ranker.obstacles.clearance((e.x, e.y)) >= agent.spec.radius
+
+
+def test_evasions_start_from_a_robot_closer_to_the_wall_than_the_margin():
+    # The robot hugs the wall (clearance between its radius and radius + margin): every straight
+    # test with the margin fails at the start, yet the robot can still move away from the wall.
+    from anyplan.world import RobotState
+
+    agent = _agent_in_empty_room(v_max=1.0, omega_max=1.5, a_max=1.0, alpha_max=3.0)
+    ranker = _corridor_ranker(agent, 1.0)
+    r, m = agent.spec.radius, agent.guard.config.margin
+    y = 3.0 - 1.0 + r + 0.5 * m  # half the margin from the lower wall
+    state = RobotState(5.0, y, 0.0, 0.0, 0.0)
+    assert not ranker.obstacles.segment_free((5.0, y), (5.0, y), r + m)
+    evades = [tr for kind, tr in ranker.candidates(0.0, state, []) if kind == "evade"]
+    assert evades
+    ts = np.linspace(0.0, 1.0, 201)
+    for tr in evades:  # none comes closer to the walls than the robot's bare radius
+        p = tr.positions(ts * float(tr.t_end))
+        assert min(ranker.obstacles.clearance(tuple(q)) for q in p) >= r - 1e-9
+
+
 def test_when_no_fallback_is_passively_safe_the_one_at_rest_soonest_ranks_first():
     # A standing person 1.2 m ahead of a robot at 1 m/s, reachable at 1.6 m/s: no escape is at
     # rest before the person could reach it. Braking now (at rest in 1 s) outranks driving on
