@@ -407,7 +407,7 @@ def test_fallback_struck_at_rest_beats_one_struck_soon_after_driving_into_it():
     agent = _agent_in_empty_room(v_max=0.2, omega_max=1.0, a_max=1.0, alpha_max=2.0)
     ranker = agent._ranker()
     gap = agent.spec.radius + 0.25 + agent.guard.config.margin
-    west, hold, drive, h_hold, h_drive = _struck_pair(agent, 3.0 + gap + 0.3, 2.9)
+    west, hold, drive, _, h_drive = _struck_pair(agent, 3.0 + gap + 0.3, 2.9)
     assert h_drive.t < ranker.react_s  # both contacts are near
     k_hold, _ = agent._fallback_rank(hold, 0.0, west, west)
     k_drive, _ = agent._fallback_rank(drive, 0.0, west, west)
@@ -421,7 +421,7 @@ def test_fallback_struck_later_than_the_reaction_time_beats_a_hold_struck_sooner
     # contact does not decide, the later contact does (a hold struck sooner is no safer).
     agent = _agent_in_empty_room(v_max=0.2, omega_max=1.0, a_max=1.0, alpha_max=2.0)
     ranker = agent._ranker()
-    west, hold, drive, h_hold, h_drive = _struck_pair(agent, 12.0, 1.0)
+    west, hold, drive, h_hold, _ = _struck_pair(agent, 12.0, 1.0)
     assert h_hold.t > ranker.react_s
     k_hold, _ = agent._fallback_rank(hold, 0.0, west, west)
     k_drive, _ = agent._fallback_rank(drive, 0.0, west, west)
