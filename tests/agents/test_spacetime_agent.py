@@ -479,6 +479,48 @@ def test_evasions_start_from_a_robot_closer_to_the_wall_than_the_margin():
         assert min(ranker.obstacles.clearance(tuple(q)) for q in p) >= r - 1e-9
 
 
+def test_a_stoppable_motion_struck_later_gives_way_to_a_free_evasion():
+    # A hold at (3, 3) is "stoppable" (at rest already) but an obstacle coming west along
+    # y = 3 strikes it within the guard's horizon; stepping aside is free of every disc, so
+    # freer_evasion offers it. A motion that nothing strikes keeps its place (None).
+    from anyplan.agents.evasion import freer_evasion
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.prediction.collision import first_collision
+    from anyplan.trajectory.reference import HoldSegment
+    from anyplan.trajectory.trajectory import Trajectory
+    from anyplan.world import RobotState, UnicycleMotion
+
+    agent = _agent_in_empty_room(v_max=1.0, omega_max=1.5, a_max=1.0, alpha_max=3.0)
+    ranker = agent._ranker()
+    state = RobotState(3.0, 3.0, 0.0, 0.0, 0.0)
+    hold = Trajectory([HoldSegment(3.0, 3.0, 0.0, 0.0, 8.0)], kind="hold")
+    west = [PredictedObstacle("W", 0.25, UnicycleMotion(8.0, 3.0, math.pi, 1.0))]
+    h = agent.guard.config.horizon_s
+    hit = first_collision(hold, west, agent.spec.radius, t_from=0.0, t_until=h,
+                          margin=agent.guard.config.margin)
+    assert hit is not None and hit.t > 1.0  # struck, after the robot could have moved
+    better = freer_evasion(ranker, 0.0, state, west, west, hold)
+    assert better is not None
+    kind, tr, clear = better
+    assert kind != "hold" and clear >= agent.guard.config.margin
+    assert first_collision(tr, west, agent.spec.radius, t_from=0.0, t_until=h,
+                           margin=agent.guard.config.margin) is None
+    away = [PredictedObstacle("W", 0.25, UnicycleMotion(8.0, 3.0, 0.0, 1.0))]  # going east
+    assert freer_evasion(ranker, 0.0, state, away, away, hold) is None
+
+
+def test_the_prediction_horizon_covers_a_slow_robots_escape_time():
+    # A robot that turns at 0.4 rad/s and drives at 0.4 m/s needs about 9 s to leave an
+    # obstacle's way: predictions are extrapolated that long, not 3 s; a fast robot keeps 3 s.
+    from anyplan.agents.evasion import escape_time_s
+
+    slow = _agent_in_empty_room(v_max=0.4, omega_max=0.4, a_max=0.4, alpha_max=1.0)
+    assert escape_time_s(slow.spec) > 8.0
+    assert slow.prediction_horizon_s == pytest.approx(escape_time_s(slow.spec))
+    fast = _agent_in_empty_room(v_max=2.0, omega_max=3.0, a_max=3.0, alpha_max=8.0)
+    assert escape_time_s(fast.spec) < 3.0 and fast.prediction_horizon_s == 3.0
+
+
 def test_when_no_fallback_is_passively_safe_the_one_at_rest_soonest_ranks_first():
     # A standing person 1.2 m ahead of a robot at 1 m/s, reachable at 1.6 m/s: no escape is at
     # rest before the person could reach it. Braking now (at rest in 1 s) outranks driving on

@@ -22,14 +22,18 @@ from anyplan.prediction.collision import PredictedCollision, first_collision
 from anyplan.trajectory.motion import plan_motion, polyline_trajectory
 from anyplan.world.robot import RobotSpec, RobotState
 
-__all__ = ["APPROACH_TOL", "MIN_EVADE_M", "FallbackRanker", "approach_speed", "best_fallback",
-           "free_length"]
+__all__ = ["APPROACH_TOL", "EVADE_M", "MIN_EVADE_M", "FallbackRanker", "approach_speed",
+           "best_fallback", "escape_time_s", "free_length", "freer_evasion"]
 
 #: Approach speed [m/s] at a predicted contact below which it counts as none (at rest or
 #: moving away; well below the 0.05 m/s robot-caused threshold of
 #: :mod:`anyplan.simulation.contact`, which a slow creep at contact would cross on execution).
 APPROACH_TOL = 1e-3
 
+
+#: An evasion drives v_max x 1.5 s, but at least this far [m]: a slow robot (0.4 m/s) would
+#: otherwise move 0.6 m, less than the width of a person's disc plus its own.
+EVADE_M = 1.5
 
 #: Shortest evasion [m]: a direction whose free run from the robot is shorter is left out.
 MIN_EVADE_M = 0.3
@@ -185,7 +189,7 @@ class FallbackRanker:
             # closer to a wall than the margin (a path that hugged it): evasions may keep the
             # clearance the robot has now, down to its bare radius, or none would start
             radius = max(spec.radius, clear0 - 1e-9)
-        dist = 1.5 * spec.v_max
+        dist = max(1.5 * spec.v_max, EVADE_M)
         for k in range(8):
             a = state.theta + k * math.pi / 4.0
             u = np.array([math.cos(a), math.sin(a)])
@@ -217,3 +221,39 @@ def best_fallback(ranker: FallbackRanker, t: float, state: RobotState,
               for kind, tr in ranker.candidates(t, state, full, motion, current)]
     (_, clear), kind, tr = max(ranked, key=lambda c: c[0][0])
     return kind, tr, clear
+
+
+def freer_evasion(ranker: FallbackRanker, t: float, state: RobotState,
+                  full: Sequence[PredictedObstacle], planned: Sequence[PredictedObstacle],
+                  motion: Any, reach: Sequence[PredictedObstacle] = ()
+                  ) -> tuple[str, Any, float] | None:
+    """The best fallback (:func:`best_fallback`, without ``motion``) when it is free of the
+    full or of the planned discs where ``motion`` is not, else None.
+
+    For a motion the guard accepts as *stoppable* (it can brake before its predicted
+    collision): the invariant lets it start, but braking on it may stand the robot where the
+    obstacle passes, a collision too (measured on the gap worlds with noise, where a slow robot
+    waited in a walker's way). An evasion that no disc strikes is better.
+    """
+    k_motion, _ = ranker.rank(motion, t, full, planned, reach)
+    kind, tr, clear = best_fallback(ranker, t, state, full, planned, None, None, reach)
+    if ranker.rank(tr, t, full, planned, reach)[0][:4] <= k_motion[:4]:
+        return None
+    return kind, tr, clear
+
+
+def escape_time_s(spec: RobotSpec) -> float:
+    """Time [s] a robot at rest needs to get out of an obstacle's way: a quarter turn
+    (reaching omega_max first), then one diameter plus 1 m sideways (reaching v_max first).
+    ``st-bitstar`` extrapolates an unannounced motion at least this long: a shorter horizon
+    would show a slow robot the collision only once it can no longer leave.
+
+    Examples:
+        >>> from anyplan.world.robot import RobotSpec
+        >>> jackal = RobotSpec((0.0, 0.0, 0.0), (1.0, 0.0), radius=0.34, v_max=2.0, omega_max=2.0,
+        ...                    a_max=2.0, alpha_max=4.0)
+        >>> round(escape_time_s(jackal), 2)
+        3.13
+    """
+    return (0.5 * math.pi / spec.omega_max + spec.omega_max / spec.alpha_max
+            + (2.0 * spec.radius + 1.0) / spec.v_max + spec.v_max / spec.a_max)

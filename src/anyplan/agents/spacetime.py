@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from anyplan.agents.base import Observation
-from anyplan.agents.evasion import FallbackRanker, best_fallback
+from anyplan.agents.evasion import FallbackRanker, best_fallback, escape_time_s, freer_evasion
 from anyplan.agents.safety import reachable_discs
 from anyplan.agents.sequential import SequentialBITStarAgent
 from anyplan.agents.stats import SpaceTimeStats
@@ -99,7 +99,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             deterministic settings have it). Without a timed path the loop runs on.
         lattice_dt_s: Approximate step [s] of the velocity lattice.
         horizon_s: Horizon [s] of a prediction extrapolated from the current twist (perception
-            ``twist`` or ``tracked``: no announced motion); beyond it the obstacle is not checked
+            ``twist`` or ``tracked``: no announced motion), at least the robot's
+            :func:`~anyplan.agents.evasion.escape_time_s`; beyond it the obstacle is not checked
             (receding horizon, see :meth:`_planning_preds`). None: predictions never end.
         plan_extra_m: With such predictions, paths are planned and timed against discs whose
             extra radius is capped at this [m]; the safety guard checks every motion against
@@ -108,17 +109,13 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             exact twists (``twist``) are planned against in full; ``"horizon"``: both apply to
             every prediction without an announced motion; ``"never"``: the horizon without the
             guard.
-        manoeuvre_accel: A manoeuvre allowance [m/s^2] for exact twists (``twist``
-            perception): their discs grow by ``manoeuvre_accel tau^2 / 2`` up to 1 m
-            (:func:`~anyplan.prediction.base.manoeuvre_growth`), so they are uncertain and the
-            receding horizon and the guard apply to them as to tracked ones. 0: exact twists
-            are planned against in full (the default; docs/perception.md has the figures).
-        passive_safety: With predictions of unknown futures (``twist``, ``tracked``), every
-            motion started or kept must also be passively safe: its escape brings the robot to
-            rest before any obstacle ahead could reach it at its predicted speed plus
-            ``reach_extra_mps`` (:func:`~anyplan.agents.safety.reachable_discs`), so that an
-            obstacle leaving its prediction (turning at a corner) meets a robot at rest, not
-            one driving into it. The robot slows down near obstacles it cannot predict.
+        manoeuvre_accel: A manoeuvre allowance [m/s^2] for exact twists (``twist``): their
+            discs grow by ``manoeuvre_accel tau^2 / 2`` up to 1 m (uncertain, so the horizon and
+            the guard apply as to tracked ones). 0: planned against in full (the default).
+        passive_safety: With unknown futures (``twist``, ``tracked``), every motion started or
+            kept must be passively safe: its escape is at rest before any obstacle ahead could
+            reach it at its predicted speed + ``reach_extra_mps``
+            (:func:`~anyplan.agents.safety.reachable_discs`): one that turns meets a robot at rest.
         reach_extra_mps: Speed [m/s] added to each obstacle's predicted speed for its
             reachable disc.
         reach_min_speed_mps: Least speed [m/s] of a reachable disc's growth, whatever the
@@ -190,7 +187,10 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
 
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
         super().reset(scenario, rng)  # loads the kernel parts, "spacetime" among them
-        self.predictor = ConstantTwistPredictor(horizon_s=self.horizon_s,
+        # at least the time this robot needs to get out of an obstacle's way from rest
+        self.prediction_horizon_s = (None if self.horizon_s is None else
+                                     max(self.horizon_s, escape_time_s(self.spec)))
+        self.predictor = ConstantTwistPredictor(horizon_s=self.prediction_horizon_s,
                                                 manoeuvre_accel=self.manoeuvre_accel)
         self._cands: list[tuple[float, Trajectory, np.ndarray, list[Shape]]] = []
         self._tried: list[tuple[np.ndarray, list[Shape]]] = []
@@ -372,7 +372,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                reason: str) -> tuple[str, Trajectory | None]:
         """The safety invariant against the full uncertain predictions ``safe``: start
         ``motion`` at ``t_switch`` [s] if it is free to rest or stoppable there, else keep the
-        current motion if it still is, else the best of :meth:`_evasions`. With
+        current motion if it still is, else the best of :meth:`_evasions`; a stoppable one
+        gives way to an evasion that is free where it is not (``freer_evasion``). With
         ``passive_safety``, both must also be passively safe against the reachable discs of
         the ``observed`` predictions (:meth:`_reach`). Returns the decision's kind and
         trajectory."""
@@ -383,11 +384,20 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit, reach,
                                 fallback=False)
         if dec.kind in ("motion", "keep"):
-            return dec.kind, dec.trajectory
-        kind, tr, clear = self._evasions(t_switch, state, safe, motion, self.trajectory, reach)
-        self.record.fallbacks.append(
-            {"t": float(obs.t), "kind": kind, "reason": dec.reason or reason,
-             "predicted_clearance_m": _finite(clear)})
+            if dec.rule != "stoppable":
+                return dec.kind, dec.trajectory
+            # stoppable, but struck later: it may stand the robot where the obstacle passes
+            better = freer_evasion(self._ranker(), t_switch, state, safe, self._capped(safe),
+                                   dec.trajectory, reach)
+            if better is None:
+                return dec.kind, dec.trajectory
+            (kind, tr, clear), why = better, (f"{dec.kind}: stoppable, collision predicted at "
+                                              f"{dec.first_collision_s:.2f} s; an evasion is free")
+        else:
+            (kind, tr, clear), why = self._evasions(t_switch, state, safe, motion,
+                                                    self.trajectory, reach), dec.reason or reason
+        self.record.fallbacks.append({"t": float(obs.t), "kind": kind, "reason": why,
+                                      "predicted_clearance_m": _finite(clear)})
         return kind, tr
 
     def _reach(self, observed: list[PredictedObstacle], t: float,
@@ -470,8 +480,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 res = SequentialResult("collision_free", rest, out, [], 0)
         # Long waits are useless with predictions that end before patience_s: nothing is left
         # to wait for.
-        long_ok = not (uncertain and self.horizon_s is not None
-                       and self.patience_s >= self.horizon_s)
+        long_ok = not (uncertain and self.prediction_horizon_s is not None
+                       and self.patience_s >= self.prediction_horizon_s)
         long_bound = self.branch_and_bound and not uncertain
         if res is None:
             # With certain predictions, branch and bound over the loop's paths: the shortest
@@ -544,8 +554,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             return None
         self._cands = []
         wait = self.max_wait_s
-        if self.horizon_s is not None and any(o.until < math.inf for o in self._preds):
-            wait = min(wait, self.horizon_s + self.patience_s)
+        if self.prediction_horizon_s is not None and any(o.until < math.inf
+                                                         for o in self._preds):
+            wait = min(wait, self.prediction_horizon_s + self.patience_s)
         self._timed_fn(state, t_switch, wait)(np.asarray(path), shapes, 0.0)
         return self._cands[0][1] if self._cands else None
 
