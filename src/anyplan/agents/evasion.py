@@ -217,10 +217,18 @@ def best_fallback(ranker: FallbackRanker, t: float, state: RobotState,
     """``(kind, trajectory, clearance [m])`` of the best of :meth:`FallbackRanker.candidates`
     by :meth:`FallbackRanker.rank` (the first on a tie: keeping ``current`` is taken only when
     strictly better)."""
+    (_, clear), kind, tr = _best_ranked(ranker, t, state, full, planned, motion, current, reach)
+    return kind, tr, clear
+
+
+def _best_ranked(ranker: FallbackRanker, t: float, state: RobotState,
+                 full: Sequence[PredictedObstacle], planned: Sequence[PredictedObstacle],
+                 motion: Any, current: Any, reach: Sequence[PredictedObstacle]
+                 ) -> tuple[tuple[tuple[Any, ...], float], str, Any]:
+    """``((key, clearance [m]), kind, trajectory)`` of the best candidate (the first on a tie)."""
     ranked = [(ranker.rank(tr, t, full, planned, reach), kind, tr)
               for kind, tr in ranker.candidates(t, state, full, motion, current)]
-    (_, clear), kind, tr = max(ranked, key=lambda c: c[0][0])
-    return kind, tr, clear
+    return max(ranked, key=lambda c: c[0][0])
 
 
 def freer_evasion(ranker: FallbackRanker, t: float, state: RobotState,
@@ -236,8 +244,8 @@ def freer_evasion(ranker: FallbackRanker, t: float, state: RobotState,
     waited in a walker's way). An evasion that no disc strikes is better.
     """
     k_motion, _ = ranker.rank(motion, t, full, planned, reach)
-    kind, tr, clear = best_fallback(ranker, t, state, full, planned, None, None, reach)
-    if ranker.rank(tr, t, full, planned, reach)[0][:4] <= k_motion[:4]:
+    (k_best, clear), kind, tr = _best_ranked(ranker, t, state, full, planned, None, None, reach)
+    if k_best[:4] <= k_motion[:4]:
         return None
     return kind, tr, clear
 

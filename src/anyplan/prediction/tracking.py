@@ -248,13 +248,14 @@ class Tracker:
         P = np.diag([r2, r2, cfg.init_speed_sigma ** 2, cfg.init_speed_sigma ** 2, 0.3 ** 2])
         return x, P
 
-    def _outside_gate(self, idx: np.ndarray, z: np.ndarray) -> np.ndarray:
+    def _outside_gate(self, idx: np.ndarray, z: np.ndarray, md: np.ndarray) -> np.ndarray:
         """Tracks ``idx`` (predicted to the detection time) whose detection z (N, 2) is farther
-        than ``gate_m`` from the predicted position and outside the gate of every model."""
+        than ``gate_m`` from the predicted position and outside the gate of every model (``md``:
+        their :meth:`_squared_distances`)."""
         cfg = self.config
         y = z[:, None, :] - self.x[idx][:, :, :2]
         far = np.hypot(y[..., 0], y[..., 1]).min(axis=1) > cfg.gate_m
-        return far & (self._squared_distances(idx, z).min(axis=1) > cfg.gate_chi2)
+        return far & (md.min(axis=1) > cfg.gate_chi2)
 
     def _add(self, d: Detection) -> None:
         x, P = self._initial(d)
@@ -286,7 +287,8 @@ class Tracker:
             idx = np.array([i for i, _ in upd])
             steps = self._predict(idx, t)
             z = np.array([[d.x, d.y] for _, d in upd])
-            jumped = self._outside_gate(idx, z)
+            md = self._squared_distances(idx, z)  # the gate's and the manoeuvre test's
+            jumped = self._outside_gate(idx, z, md)
             for k in np.flatnonzero(jumped):  # restarted where it is now
                 x0, P0 = self._initial(upd[k][1])
                 self.x[idx[k]], self.P[idx[k]], self.mu[idx[k]] = x0, P0, (0.8, 0.2)
@@ -294,7 +296,7 @@ class Tracker:
                 self.restarted += 1
             if (~jumped).any():
                 ii, zz = idx[~jumped], z[~jumped]
-                man = self._squared_distances(ii, zz).min(axis=1) > self.config.manoeuvre_chi2
+                man = md[~jumped].min(axis=1) > self.config.manoeuvre_chi2
                 if man.any() and self.config.q_manoeuvre > 0.0:
                     q = _accel_q(steps[~jumped][man], self.config.q_manoeuvre)
                     self.P[ii[man]] += q[:, None, :, :]  # both models
