@@ -174,3 +174,34 @@ def test_second_process_fills_the_cache_that_this_process_then_loads(no_parts_lo
     out = subprocess.run([sys.executable, "-c", probe], env=dict(os.environ), capture_output=True,
                          text=True, timeout=600, check=True)
     assert out.stdout.strip() == "0"  # everything loaded from the cache the second process wrote
+
+
+def test_stmap_part_loads_no_kernel_of_the_motion_part():
+    """The s-t map part runs while a second process compiles the motion part (the parts' order
+    in PARTS puts it first): it must not need that part's kernels, or it would compile them again
+    on this side."""
+    import subprocess
+    import sys
+
+    probe = (
+        "import sys, importlib\n"
+        "from anyplan.agents.warmup import warm_up_kernels\n"
+        "warm_up_kernels(['stmap'])\n"
+        "from numba.core.registry import CPUDispatcher\n"
+        "used = set()\n"
+        "for name, mod in list(sys.modules.items()):\n"
+        "    if name.startswith('anyplan.'):\n"
+        "        for attr in vars(mod).values():\n"
+        "            if isinstance(attr, CPUDispatcher) and attr.signatures:\n"
+        "                used.add(attr.py_func.__module__)\n"
+        "print(' '.join(sorted(used)))\n")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         timeout=600, check=True)
+    used = out.stdout.split()
+    assert "anyplan.trajectory.spacetime.stmap" in used  # the probe sees what ran
+    assert "anyplan.trajectory.spacetime._lattice_kernels" in used
+    motion = [m for m in used if m.startswith(("anyplan.trajectory.spline", "anyplan.trajectory.profile",
+                                               "anyplan.trajectory.brake", "anyplan.trajectory.turn",
+                                               "anyplan.trajectory._path"))]
+    assert motion == []
+    assert PARTS.index("stmap") < PARTS.index("motion")

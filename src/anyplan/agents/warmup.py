@@ -2,13 +2,10 @@
 
 anyplan's hot loops are numba functions compiled on first use and cached on disk
 (``cache=True``): the first process on a machine compiles them, later ones load the cached
-code. Agents call :func:`warm_up_kernels` in ``reset`` with the parts they use (``"bitstar"``:
-BIT*'s search; ``"motion"``: smoothing, speed profile and sampling; ``"sequential"``: collision
-prediction and one replanning around a crossing obstacle; ``"spacetime"``: the s-t map, the
-velocity lattice, the certified re-check and the detours' disconnection proof of st-bitstar),
-so that neither cost lands inside a timed planning call: loading a planner's code is a start-up
-cost, not part of a replanning. ``on_compile`` is called once, when numba really compiles (a
-cache miss), so a command can say "compiling" only when it is.
+code. Agents call :func:`warm_up_kernels` in ``reset`` with the parts they use (:data:`PARTS`,
+each described by its function below), so that neither cost lands inside a timed planning call:
+loading a planner's code is a start-up cost, not part of a replanning. ``on_compile`` is called
+once, when numba really compiles (a cache miss), so a command can say "compiling" only when it is.
 
 numba compiles under the interpreter's lock, one function at a time, so a thread cannot share the
 work; a second *process* can. :func:`prefetch_kernels` starts one that compiles a part into the
@@ -36,7 +33,7 @@ __all__ = ["warm_up_kernels", "PARTS", "compiling_notifier", "prefetch_kernels",
 
 logger = logging.getLogger(__name__)
 #: Every part, in the order they are loaded.
-PARTS = ("bitstar", "motion", "sequential", "spacetime")
+PARTS = ("bitstar", "stmap", "motion", "sequential", "spacetime")
 _DONE: set[str] = set()
 #: A part that a second process may compile while this one compiles the others: it shares no
 #: kernel with loading a scenario, the time lower bound or BIT*'s part (``sequential`` runs
@@ -208,6 +205,7 @@ def _child() -> None:
 
 
 def _bitstar() -> None:
+    """BIT*'s search."""
     from anyplan.planning.bitstar import warm_up as warm_up_bitstar
 
     warm_up_bitstar()
@@ -225,6 +223,7 @@ def _scene():  # noqa: ANN202 - small fixture shared by the motion and sequentia
 
 
 def _motion() -> None:
+    """Smoothing, certification, speed profile and sampling of a motion."""
     from anyplan.trajectory.motion import plan_motion
     from anyplan.world.robot import RobotState
 
@@ -237,6 +236,7 @@ def _motion() -> None:
 
 
 def _sequential() -> None:
+    """Collision prediction, and one Sequential BIT* replanning around a crossing obstacle."""
     from anyplan.planning.sequential import SequentialBITStar, SequentialConfig
     from anyplan.prediction.base import PredictedObstacle
     from anyplan.prediction.collision import first_collision
@@ -268,7 +268,34 @@ def _sequential() -> None:
     loop.replan(np.array([0.5, 3.0]), np.array([3.5, 0.5]), [crossing], 0.0)
 
 
+def _stmap() -> None:
+    """The s-t map, the velocity lattice and the detours' disconnection proof: kernels that call
+    none of the motion part's, so this process compiles them while a second one compiles that
+    part (the straight path below is numpy, not a smoothed curve)."""
+    from anyplan.geometry.collision import ObstacleSet
+    from anyplan.planning.connectivity import provably_disconnected
+    from anyplan.prediction.base import PredictedObstacle
+    from anyplan.trajectory.spacetime import build_stmap, plan_velocity
+    from anyplan.world.motion import UnicycleMotion
+
+    a, b = np.array([0.5, 0.5]), np.array([3.5, 0.5])
+    length = float(np.hypot(*(b - a)))
+
+    def points_at(s: np.ndarray) -> np.ndarray:
+        return a + np.outer(s / length, b - a)
+
+    mover = PredictedObstacle("X", 0.2, UnicycleMotion(2.0, 1.9, -1.5708, 0.3))
+    st = build_stmap(points_at, length, [mover], 0.2, 0.0, 8.0)
+    caps = np.full(st.forbidden.shape[1], 1.0)
+    for v0 in (0.0, 0.3):  # on the lattice's speed levels, and between two (its first step)
+        plan_velocity(st.forbidden, st.t_map, st.h, st.ds, caps, caps, length, 0.0, v0, 0.5, 1.0,
+                      horizon_s=8.0)
+    provably_disconnected(ObstacleSet([], bounds=(0.0, 0.0, 4.0, 2.0)), (0.5, 0.5), (3.5, 0.5),
+                          0.2)
+
+
 def _spacetime() -> None:
+    """st-bitstar's timing of a smoothed motion among moving discs and its certified check."""
     from anyplan.geometry.collision import ObstacleSet
     from anyplan.planning.connectivity import provably_disconnected
     from anyplan.prediction.base import PredictedObstacle
@@ -287,7 +314,8 @@ def _spacetime() -> None:
     provably_disconnected(obs, (0.5, 0.5), (3.5, 0.5), spec.radius)  # the detours' proof
 
 
-_RUN = {"bitstar": _bitstar, "motion": _motion, "sequential": _sequential, "spacetime": _spacetime}
+_RUN = {"bitstar": _bitstar, "stmap": _stmap, "motion": _motion, "sequential": _sequential,
+        "spacetime": _spacetime}
 
 
 def warm_up_kernels(parts: Iterable[str] = PARTS,

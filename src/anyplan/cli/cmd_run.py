@@ -15,7 +15,7 @@ from anyplan.errors import UsageError
 from anyplan.simulation.simulator import SimConfig, simulate
 from anyplan.world.scenario import builtin_scenarios, load_scenario
 
-DEFAULT_PLANNER = "seq-bitstar"
+DEFAULT_PLANNER = "st-bitstar"
 
 EXIT_CODES = """\
 exit codes:
