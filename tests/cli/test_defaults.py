@@ -1,5 +1,6 @@
-"""Defaults that point at what matters: bench's planners, bench-planning without OMPL on problems
-where planners differ, and ``moving_obstacles`` as another name for ``dynamic_obstacles``."""
+"""Defaults that point at what matters: run's planner, bench's planners, bench-planning without
+OMPL on problems where planners differ, and ``moving_obstacles`` as another name for
+``dynamic_obstacles``."""
 
 from __future__ import annotations
 
@@ -15,6 +16,17 @@ from anyplan.experiments.db import ResultsDB
 from anyplan.experiments.planning_problems import cluttered_world, planning_suite
 from anyplan.planning import Problem, lower_bound
 from tests.conftest import small_scenario_dict
+
+
+def test_run_plans_with_st_bitstar_unless_told_and_it_reaches_safely(tmp_path):
+    # st-bitstar beat seq-bitstar on every suite of issue 10 (docs/spacetime.md, "Targets"), so
+    # `anyplan run` uses it; paper-3 (three walkers) is the README's first command.
+    import json
+
+    assert main(["run", "paper-3", "--deterministic", "--no-plot", "--out", str(tmp_path)]) == 0
+    res = json.loads((tmp_path / "result.json").read_text())
+    assert res["planner"] == "st-bitstar"
+    assert res["status"] == "reached" and not res["collision"]
 
 
 def test_bench_defaults_to_the_paper_comparison():
