@@ -18,7 +18,7 @@ from anyplan.planning import Problem, lower_bound
 from tests.conftest import small_scenario_dict
 
 
-def test_run_plans_with_st_bitstar_unless_told_and_it_reaches_safely(tmp_path):
+def test_run_plans_with_st_bitstar_unless_told_and_it_reaches_safely(tmp_path, capsys):
     # st-bitstar beat seq-bitstar on every suite of issue 10 (docs/spacetime.md, "Targets"), so
     # `anyplan run` uses it; paper-3 (three walkers) is the README's first command.
     import json
@@ -27,6 +27,11 @@ def test_run_plans_with_st_bitstar_unless_told_and_it_reaches_safely(tmp_path):
     res = json.loads((tmp_path / "result.json").read_text())
     assert res["planner"] == "st-bitstar"
     assert res["status"] == "reached" and not res["collision"]
+    # the printed summary counts what result.json holds, in English ("1 call", "0 replans")
+    n, r = len(res["planning_times_s"]), res["replans"]
+    line = next(s for s in capsys.readouterr().out.splitlines() if s.strip().startswith("planning"))
+    assert f"{n} call{'' if n == 1 else 's'}," in line
+    assert line.endswith(f"{r} replan{'' if r == 1 else 's'}")
 
 
 def test_bench_defaults_to_the_paper_comparison():

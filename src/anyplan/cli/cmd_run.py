@@ -152,6 +152,11 @@ def _run(args: argparse.Namespace) -> int:
     return 0 if result.reached_goal else 1
 
 
+def _count(n: int, noun: str) -> str:
+    """``"1 call"``, ``"2 calls"``."""
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
 def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
     """A few human-readable lines about a run."""
     pt = result.planning_times_s
@@ -166,7 +171,8 @@ def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
            if result.time_over_lower_bound is not None else ""),
         f"  path length    {result.path_length_m:.3f} m",
         f"  min clearance  {result.min_clearance_m:.3f} m",
-        f"  planning       {len(pt)} calls, {sum(pt):.3f} s total, {result.replans} replans",
+        f"  planning       {_count(len(pt), 'call')}, {sum(pt):.3f} s total, "
+        f"{_count(result.replans, 'replan')}",
         *([f"  fallbacks      {len(result.extra['fallbacks'])}"]
           if result.extra.get("fallbacks") else []),
         f"  wrote          {out / 'result.json'}",
