@@ -189,6 +189,7 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
     if t1 < t0 or not obstacles:
         return out
     extra = 0.0
+    true_motion = motion  # the contact's robot position is the motion's, not the samples'
     if sample_dt is not None:
         motion = SampledMotion(motion, t0, t1, sample_dt)
         extra = motion.error_bound
@@ -261,8 +262,8 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
         if tc is None:
             continue
         ta = np.array([tc])
-        hit = PredictedCollision(o.name, float(tc), motion.positions(ta)[0], o.positions(ta)[0],
-                                 float(o.radius_at(float(tc))))
+        hit = PredictedCollision(o.name, float(tc), true_motion.positions(ta)[0],
+                                 o.positions(ta)[0], float(o.radius_at(float(tc))))
         out.append(hit)
         out.sort(key=lambda c: c.t)
     return out
