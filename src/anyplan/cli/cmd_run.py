@@ -81,7 +81,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     if note.compiled:
         more, waited = prefetch_report()
         n = note.count + more
-        what = f"{n} function" + ("s" if n != 1 else "")
+        what = _count(n, "function")
         where = f", {more} of them in a second process" if more else ""
         sys.stderr.write(f"anyplan: compiled {what} in {note.seconds + waited:.1f} s{where} "
                          "(once: later runs load them from the cache)\n")

@@ -215,20 +215,23 @@ class Tracker:
         self.t[idx] = t
         return T
 
+    def _innovation(self, x: np.ndarray, P: np.ndarray, z: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+        """Innovations y (N, 2 models, 2) of positions z (N, 2) against states x (N, 2, 5) with
+        covariances P (N, 2, 5, 5), and their covariances S (N, 2, 2, 2)."""
+        r2 = max(self.config.sigma_m, 1e-3) ** 2
+        return z[:, None, :] - x[:, :, :2], P[:, :, :2, :2] + r2 * np.eye(2)
+
     def _squared_distances(self, idx: np.ndarray, z: np.ndarray) -> np.ndarray:
         """Squared Mahalanobis distances (N, 2) of positions z (N, 2) from tracks ``idx``
         (predicted to the detection time) under each model."""
-        r2 = max(self.config.sigma_m, 1e-3) ** 2
-        y = z[:, None, :] - self.x[idx][:, :, :2]
-        S = self.P[idx][:, :, :2, :2] + r2 * np.eye(2)
+        y, S = self._innovation(self.x[idx], self.P[idx], z)
         return np.asarray(np.einsum("nma,nmab,nmb->nm", y, np.linalg.inv(S), y))
 
     def _update(self, idx: np.ndarray, z: np.ndarray) -> None:
         """Kalman update of tracks ``idx`` (already at the detection time) with positions z (N, 2)."""
-        r2 = max(self.config.sigma_m, 1e-3) ** 2
         x, P = self.x[idx], self.P[idx]
-        y = z[:, None, :] - x[:, :, :2]                   # innovation (n, m, 2)
-        S = P[:, :, :2, :2] + r2 * np.eye(2)
+        y, S = self._innovation(x, P, z)
         Sinv = np.linalg.inv(S)
         K = np.einsum("nmab,nmbc->nmac", P[:, :, :, :2], Sinv)   # (n, m, 5, 2)
         x = x + np.einsum("nmab,nmb->nma", K, y)
