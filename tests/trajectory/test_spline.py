@@ -64,6 +64,21 @@ def test_clean_path_drops_duplicates_and_collinear_points():
         SmoothCurve(np.array([[0.0, 0.0]]))
 
 
+def test_remaining_path_starts_at_the_robot_and_drops_what_is_behind():
+    from anyplan.trajectory.path import remaining_path
+
+    path = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 3.0]])
+    # beside the first segment: the rest is the robot, then the corner and the end
+    np.testing.assert_allclose(remaining_path(path, np.array([1.0, 0.2])),
+                               [[1.0, 0.2], [4.0, 0.0], [4.0, 3.0]])
+    # nearest to the second segment: the corner is behind
+    np.testing.assert_allclose(remaining_path(path, np.array([3.9, 2.0])), [[3.9, 2.0], [4.0, 3.0]])
+    # on the corner itself: the corner is not repeated
+    np.testing.assert_allclose(remaining_path(path, np.array([4.0, 0.0])), [[4.0, 0.0], [4.0, 3.0]])
+    # past the end: the robot and the end
+    np.testing.assert_allclose(remaining_path(path, np.array([4.0, 5.0])), [[4.0, 5.0], [4.0, 3.0]])
+
+
 @pytest.mark.parametrize("seed", range(25))
 def test_certification_never_misses_a_contact(seed):
     rng = np.random.default_rng(seed)

@@ -32,7 +32,8 @@ from anyplan.trajectory.trajectory import BrakeSegment, Trajectory
 from anyplan.world.motion import UnicycleMotion
 from anyplan.world.robot import RobotSpec, RobotState
 
-__all__ = ["SafetyConfig", "Decision", "Escape", "SafetyGuard", "FALLBACK_KINDS", "reachable_discs"]
+__all__ = ["SafetyConfig", "Decision", "Escape", "SafetyGuard", "FALLBACK_KINDS", "reachable_discs",
+           "finite_or_none"]
 
 #: The fallback kinds, in order of preference when their clearances tie.
 FALLBACK_KINDS = ("hold", "brake", "turn_away", "back_off")
@@ -254,7 +255,7 @@ class SafetyGuard:
         self.decisions.append(d)
         if d.kind in FALLBACK_KINDS:
             self.fallbacks.append({"t": float(d.t), "kind": d.kind,
-                                   "predicted_clearance_m": _finite(d.predicted_clearance_m)})
+                                   "predicted_clearance_m": finite_or_none(d.predicted_clearance_m)})
         return d
 
     def log(self) -> list[dict[str, Any]]:
@@ -421,7 +422,8 @@ def _max_radius(o: Any) -> float:
     return float(getattr(o, "max_radius", o.radius))
 
 
-def _finite(x: float | None) -> float | None:
+def finite_or_none(x: float | None) -> float | None:
+    """``x`` as a float, or None when it is None or not finite (for JSON records)."""
     if x is None:
         return None
     return float(x) if math.isfinite(x) else None

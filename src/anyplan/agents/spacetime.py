@@ -27,13 +27,14 @@ import numpy as np
 
 from anyplan.agents.base import Observation
 from anyplan.agents.evasion import FallbackRanker, best_fallback, escape_time_s, freer_evasion
-from anyplan.agents.safety import reachable_discs
+from anyplan.agents.safety import finite_or_none, reachable_discs
 from anyplan.agents.sequential import SequentialBITStarAgent
 from anyplan.agents.stats import SpaceTimeStats
 from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import MotionModel, SequentialConfig, SequentialResult
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle, RadiusGrowth
 from anyplan.trajectory.kinds import ST_PREFIX, MotionKind
+from anyplan.trajectory.path import remaining_path
 from anyplan.trajectory.spacetime import RowCache, retime, verify
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import RobotState
@@ -52,29 +53,11 @@ _ROW_H = 0.05
 _INSIDE_GAP_M = 0.02
 
 
-def _finite(x: float | None) -> float | None:
-    return None if x is None or not math.isfinite(x) else float(x)
-
-
 def _followable(tr: Any) -> bool:
     """Whether the robot can follow ``tr`` from its start state within its limits
     (``feasible``) without cutting a static or virtual obstacle (``certified_free``): only
     then is a prediction along ``tr`` one about where the robot goes."""
     return bool(getattr(tr, "feasible", True)) and bool(getattr(tr, "certified_free", True))
-
-
-def _remaining(path: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """The part of ``path`` (N, 2) after the point of it nearest to ``p``, starting at ``p``."""
-    a, b = path[:-1], path[1:]
-    ab = b - a
-    den = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-18)
-    u = np.clip(np.einsum("ij,ij->i", p - a, ab) / den, 0.0, 1.0)
-    d = np.hypot(*(a + u[:, None] * ab - p).T)
-    k = int(np.argmin(d))
-    rest = path[k + 1:]
-    if len(rest) and float(np.hypot(*(rest[0] - p))) < 1e-6:
-        rest = rest[1:]
-    return np.vstack([p, rest]) if len(rest) else np.vstack([p, path[-1:]])
 
 
 class SpaceTimeBITStarAgent(SequentialBITStarAgent):
@@ -397,7 +380,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             (kind, tr, clear), why = self._evasions(t_switch, state, safe, motion,
                                                     self.trajectory, reach), dec.reason or reason
         self.record.fallbacks.append({"t": float(obs.t), "kind": kind, "reason": why,
-                                      "predicted_clearance_m": _finite(clear)})
+                                      "predicted_clearance_m": finite_or_none(clear)})
         return kind, tr
 
     def _reach(self, observed: list[PredictedObstacle], t: float,
@@ -450,7 +433,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             return None
         self.record.fallbacks.append(
             {"t": float(obs.t), "kind": kind, "reason": reason,
-             "predicted_clearance_m": _finite(clear)})
+             "predicted_clearance_m": finite_or_none(clear)})
         return tr
 
     # --- planning --------------------------------------------------------------------------------
@@ -471,7 +454,7 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         if self._path is not None and len(self._path) >= 2:
             # First the path in use, from where the robot will be: no new search if it can be
             # timed within patience_s.
-            rest = _remaining(self._path, np.array([state.x, state.y]))
+            rest = remaining_path(self._path, np.array([state.x, state.y]))
             out = self._timed_fn(state, t_ready, self.patience_s)(rest, self._shapes, 0.0)
             self._tried = []
             if self._cands and out is self._cands[-1][1]:

@@ -1,4 +1,5 @@
-"""Cleaning a planned polyline before it is smoothed: repeated, collinear and skippable vertices.
+"""Cleaning a planned polyline before it is smoothed: repeated, collinear and skippable vertices;
+the rest of a path from a point on the way (:func:`remaining_path`).
 
 Sampling planners return many jittery vertices (BIT* at a fixed budget: one every few
 centimetres, off the straight line by millimetres), and a spline through all of them wiggles.
@@ -16,7 +17,7 @@ import numpy as np
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.trajectory import _path
 
-__all__ = ["clean_path", "shortcut_path"]
+__all__ = ["clean_path", "remaining_path", "shortcut_path"]
 
 
 def clean_path(path: np.ndarray, tol: float = 1e-9, collinear_tol: float = 1e-9) -> np.ndarray:
@@ -63,3 +64,18 @@ def shortcut_path(path: np.ndarray, obstacles: ObstacleSet, radius: float) -> np
         return p.copy()
     keep = _path.shortcut_indices(np.ascontiguousarray(p), radius - COLLISION_EPS, obstacles.arrays)
     return p[keep]
+
+
+def remaining_path(path: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The part of ``path`` (N, 2) [m] after its point nearest to ``p`` (2,) [m], starting at
+    ``p``: the path still ahead of a robot at ``p`` (at least ``p`` and the path's end)."""
+    a, b = path[:-1], path[1:]
+    ab = b - a
+    den = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-18)
+    u = np.clip(np.einsum("ij,ij->i", p - a, ab) / den, 0.0, 1.0)
+    d = np.hypot(*(a + u[:, None] * ab - p).T)
+    k = int(np.argmin(d))
+    rest = path[k + 1:]
+    if len(rest) and float(np.hypot(*(rest[0] - p))) < 1e-6:
+        rest = rest[1:]
+    return np.vstack([p, rest]) if len(rest) else np.vstack([p, path[-1:]])
