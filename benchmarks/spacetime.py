@@ -12,7 +12,9 @@ For each (suite, planner): success, collisions, robot-caused collisions (at firs
 robot's velocity has a component > 0.05 m/s towards the obstacle), time to goal over the time
 lower bound (the result's ``time_lower_bound_s`` when present, otherwise the same bound computed
 here: from rest under v_max and a_max along the visibility-graph shortest path to the edge of the
-goal tolerance), path length, and planning time per call (median and p95 over all calls).
+goal tolerance), path length, and planning time per call (median and p95 over all calls; the
+number of calls, and the median of the first plans from rest apart: st-bitstar's improvement
+calls, each on its budget, go on with a search the first plan's budget cut).
 
 st-bitstar and seq-bitstar run with a **fixed planning delay** of ``--delay`` seconds (0.1 by
 default): the new motion starts that long after the replanning decision whatever the computation
@@ -164,7 +166,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
                 "robot_caused": 0, "ratio_med": float(np.median(ratio)) if ratio else math.nan,
                 "len": float(np.mean([r["path_length_m"] for r in ok])) if ok else math.nan,
                 "pt_med": float(np.median([r["solve_time_s"] for r in rows])) * 1e3,
-                "pt_p95": math.nan, "fallbacks": 0}
+                "pt_p95": math.nan, "pt_first_med": math.nan, "calls": 0, "fallbacks": 0}
     pt = np.array([t for r in rows for t in r["plan_times"]]) * 1e3
     ok = [r for r in rows if r["status"] == "reached"]
     ratio = [r["time_to_goal"] / r["lower_bound"] for r in ok]
@@ -175,6 +177,9 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
             "len": float(np.mean([r["length"] for r in ok])) if ok else math.nan,
             "pt_med": float(np.median(pt)) if len(pt) else math.nan,
             "pt_p95": float(np.percentile(pt, 95)) if len(pt) else math.nan,
+            "pt_first_med": float(np.median([r["plan_times"][0] for r in rows if r["plan_times"]]))
+            * 1e3 if any(r["plan_times"] for r in rows) else math.nan,
+            "calls": int(len(pt)),
             "fallbacks": int(sum(r["fallbacks"] for r in rows))}
 
 
@@ -241,13 +246,14 @@ def main(argv: list[str] | None = None) -> int:
         groups.setdefault((r["suite"], r["planner"]), []).append(r)
     summary = {f"{s}/{p}": summarise(g) for (s, p), g in groups.items()}
     print("\n| suite | planner | runs | success | collisions | robot-caused | time / bound (median) "
-          "| path m | plan ms median | plan ms p95 | fallbacks |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          "| path m | plan ms median | plan ms p95 | calls | first plan ms median | fallbacks |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for (s, p), _ in sorted(groups.items()):
         m = summary[f"{s}/{p}"]
         print(f"| {s} | {p} | {m['runs']} | {100 * m['success']:.1f} % | {100 * m['collision']:.1f} % "
               f"| {m['robot_caused']} | {_fmt(m['ratio_med'], 3)} | {_fmt(m['len'])} "
-              f"| {_fmt(m['pt_med'], 1)} | {_fmt(m['pt_p95'], 1)} | {m['fallbacks']} |")
+              f"| {_fmt(m['pt_med'], 1)} | {_fmt(m['pt_p95'], 1)} | {m['calls']} "
+              f"| {_fmt(m['pt_first_med'], 1)} | {m['fallbacks']} |")
     for s in suites:  # ratios against seq-bitstar in this same run
         a, b = summary.get(f"{s}/st-bitstar"), summary.get(f"{s}/seq-bitstar")
         if a and b and b["pt_med"] > 0:

@@ -69,6 +69,40 @@ def test_squares_are_centred_on_the_robot_reference_at_the_collision():
     assert v.collision_time_s > 0.0
 
 
+def test_a_chain_left_off_is_taken_up_where_it_stopped():
+    # paper-3 (BIT* on batches: deterministic): the loop goes around three squares. Started
+    # again from the first square of its chain, it plans around that square from its first
+    # path on (the straight line is not tried again), counts it towards max_iterations, and
+    # ends free as well.
+    sc = load_scenario("paper-3")
+    start, goal = np.array(sc.robot.start[:2]), np.array(sc.robot.goal)
+    cfg = SequentialConfig(prediction_dt=None, batches_per_plan=2)
+    loop, preds, _ = _loop(sc, cfg)
+    full = loop.replan(start, goal, preds, 0.0)
+    assert full.collision_free and len(full.virtual_obstacles) >= 2
+    first = full.virtual_obstacles[:1]
+    loop, preds, _ = _loop(sc, cfg)
+    tried = []
+    inner = loop.motion
+
+    def spy(path, shapes, delay):
+        tried.append(list(shapes))
+        return inner(path, shapes, delay)
+
+    res = loop.replan(start, goal, preds, 0.0, motion=spy, chain=first)
+    assert res.collision_free
+    assert all(first[0].shape in shapes for shapes in tried)
+    assert res.virtual_obstacles[0] is first[0]
+    assert res.iterations == len(res.virtual_obstacles) + 1
+    # a chain that holds the start (the robot moved into a square) is dropped
+    loop, preds, _ = _loop(sc, SequentialConfig(prediction_dt=None, batches_per_plan=2,
+                                                max_iterations=1))
+    on_start = [type(first[0])((float(start[0]), float(start[1])), 1.0, 0.0, 1.0, "D1", False)]
+    res = loop.replan(start, goal, preds, 0.0, chain=on_start)
+    assert res.status != "invalid_start" and on_start[0] not in res.virtual_obstacles
+    assert len(res.costs) == 1  # max_iterations counted from an empty chain
+
+
 def test_shrink_square_keeps_the_robot_clear():
     rng = np.random.default_rng(1)
     for _ in range(500):

@@ -29,10 +29,11 @@ from anyplan.agents.base import Observation
 from anyplan.agents.evasion import FallbackRanker, best_fallback, escape_time_s, freer_evasion
 from anyplan.agents.safety import finite_or_none, reachable_discs
 from anyplan.agents.sequential import SequentialBITStarAgent
+from anyplan.agents.st_predictions import PlanningPredictions
 from anyplan.agents.stats import SpaceTimeStats
 from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import MotionModel, SequentialConfig, SequentialResult
-from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle, RadiusGrowth
+from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
 from anyplan.trajectory.kinds import ST_PREFIX, MotionKind
 from anyplan.trajectory.path import remaining_path
 from anyplan.trajectory.spacetime import RowCache, retime, verify
@@ -47,10 +48,10 @@ _DEFAULT_LOOP = SequentialConfig(max_iterations=8, wait_delays_s=(), max_time_s=
 _LOOP_FIELDS = frozenset(f.name for f in dataclasses.fields(SequentialConfig))
 #: How far ahead [s] a motion in use is checked (a hold lasts "for ever").
 _CHECK_HORIZON_S = 60.0
+#: The reason of a replanning that goes on with a search the budget cut (``improve_calls``).
+IMPROVE = "improve"
 #: Row duration [s] of the s-t maps.
 _ROW_H = 0.05
-#: Gap [m] a predicted disc that already holds the robot is shrunk to (``_planning_preds``).
-_INSIDE_GAP_M = 0.02
 
 
 def _followable(tr: Any) -> bool:
@@ -60,7 +61,7 @@ def _followable(tr: Any) -> bool:
     return bool(getattr(tr, "feasible", True)) and bool(getattr(tr, "certified_free", True))
 
 
-class SpaceTimeBITStarAgent(SequentialBITStarAgent):
+class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
     """BIT* candidate paths, each timed among the moving obstacles (s-t velocity planning).
 
     Args:
@@ -80,6 +81,11 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             replanning that has run this long (wall clock) takes the best candidate instead of
             timing more detours (with certain predictions; None: no budget, as the
             deterministic settings have it). Without a timed path the loop runs on.
+        improve_calls: With certain predictions, when the motion taken arrives more than
+            ``accept_s`` after the earliest untimed one, the next checks search again (reason
+            "improve", each on the budget) with the motion in use as the bound to beat, going
+            on with the detours where the budget cut the search; a motion arriving a lattice
+            step earlier replaces it. At most this many calls per motion taken (0: never).
         lattice_dt_s: Approximate step [s] of the velocity lattice.
         horizon_s: Horizon [s] of a prediction extrapolated from the current twist (perception
             ``twist`` or ``tracked``: no announced motion), at least the robot's
@@ -122,8 +128,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                  horizon_s: float | None = 3.0, plan_extra_m: float | None = 0.3,
                  guard: str = "growth", manoeuvre_accel: float = 0.0,
                  passive_safety: bool = False, reach_extra_mps: float = 0.3,
-                 reach_min_speed_mps: float = 0.0, search_budget_s: float | None = 0.03,
-                 **kwargs: Any) -> None:
+                 reach_min_speed_mps: float = 0.0, search_budget_s: float | None = 0.02,
+                 improve_calls: int = 5, **kwargs: Any) -> None:
         loop = {k: kwargs.pop(k) for k in list(kwargs) if k in _LOOP_FIELDS}  # e.g. from --set
         if config is None:
             config = dataclasses.replace(_DEFAULT_LOOP, **loop)
@@ -164,6 +170,14 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             raise ValueError(f"search_budget_s: must be > 0 or null, got {search_budget_s!r}")
         self.search_budget_s = None if search_budget_s is None else float(search_budget_s)
         self._search_deadline: float | None = None
+        self._last_build: float | None = None  # wall clock [s] of the last path built
+        if not (isinstance(improve_calls, int) and improve_calls >= 0):
+            raise ValueError(f"improve_calls: must be an integer >= 0, got {improve_calls!r}")
+        self.improve_calls = improve_calls
+        #: improvement calls left for the motion in use; whether the budget cut this search;
+        #: the earliest untimed arrival [s] of the paths it tried
+        self._improve_left, self._cut, self._floor = 0, False, math.inf
+        self._chain: list[Any] = []  # the squares of the path the budget cut (improving)
         self.patience_s = float(patience_s)
         self.max_wait_s = float(max_wait_s)
         self.lattice_dt_s = float(lattice_dt_s)
@@ -204,10 +218,17 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             self._rows = RowCache(t_start, _ROW_H)  # the obstacles' s-t rows, for every candidate
 
         def build(path: np.ndarray, shapes: Sequence[Shape], delay: float) -> Trajectory:
+            now, last = time.perf_counter(), self._last_build
+            if delay == 0.0:
+                self._last_build = now
+            # anytime: a detour is timed only if it can end within the budget, the last
+            # path's cost (its BIT* search, smoothing, timing) taken as its cost
+            # (and at least one path per replanning: an improving one makes progress)
             if (first_wait_s is not None and shapes and delay == 0.0 and self._cands
-                    and self._search_deadline is not None
-                    and time.perf_counter() > self._search_deadline):
+                    and self._search_deadline is not None and last is not None
+                    and 2.0 * now - last > self._search_deadline):
                 self.record.st_pruned += 1
+                self._cut = True
                 return self._best_candidate()[1]  # anytime: the best so far
             if delay == 0.0:
                 self._tried.append((np.asarray(path), list(shapes)))
@@ -221,15 +242,18 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 self._nominals[key] = memo
             nominal = memo[0]
             wait = max_wait_s
+            if delay == 0.0 and _followable(nominal):
+                self._floor = min(self._floor, nominal.t_end)
             if first_wait_s is not None and delay == 0.0 and self._preds:
-                if not shapes:
-                    wait = first_wait_s
-                elif self._cands and _followable(nominal):
+                if self._cands and _followable(nominal):
+                    # a candidate to beat (the path in use, the motion in use, a path timed)
                     best = self._best_candidate()
                     if nominal.t_end >= best[0] - 1e-9:
                         self.record.st_pruned += 1
                         return best[1]  # free: the loop stops, the earliest candidate wins
                     wait = min(first_wait_s, best[0] - nominal.t_end)
+                elif not shapes:
+                    wait = first_wait_s
             if memo[1] is None and nominal.certified_free and delay == 0.0 and self._preds:
                 memo = (nominal, verify(nominal, self._preds, spec.radius, margin=cfg.margin,
                                         t_until=nominal.t_end) is None, memo[2])
@@ -277,78 +301,6 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         s_in = plan.s[-1] - 0.5 * self.spec.goal_tolerance
         i = int(np.searchsorted(plan.s, s_in))
         return max(0.0, float(plan.t[-1] - plan.t[min(i, len(plan.t) - 1)]))
-
-    def _planning_preds(self, preds: list[PredictedObstacle], p: np.ndarray,
-                        t: float) -> list[PredictedObstacle]:
-        """The predictions planned against from the robot's position ``p`` at ``t`` [s].
-
-        Unchanged unless some prediction has a horizon (``until``: no announced motion). Then
-        (1) a prediction that cannot come within reach of the robot before its horizon (both at
-        their top speeds) is left out, and (2) a predicted disc that already holds the robot at
-        ``t`` is shrunk to leave it just outside (by ``_INSIDE_GAP_M``): being inside is not the
-        robot's doing, and a motion that leaves the disc must not look colliding at its start
-        (holding still, or going deeper, still does as the disc comes on or grows).
-        """
-        if not preds or all(o.until == math.inf for o in preds):
-            return preds  # the same object: certain predictions
-        r, v, m = self.spec.radius, self.spec.v_max, self.config.margin
-        out = []
-        for o in preds:
-            if o.until < t:
-                continue
-            q = o.positions(np.array([t]))[0]
-            d = float(np.hypot(*(q - p)))
-            if d - (v + o.max_speed) * (o.until - t) - r - m - o.max_radius > 0.0:
-                continue  # out of reach within the horizon
-            gap = d - r - m - float(o.radius_at(t))
-            if gap < _INSIDE_GAP_M:
-                cut = _INSIDE_GAP_M - gap
-                base = max(o.radius - cut, 0.0)
-                g = o.growth
-                if g is not None and cut > o.radius - base:
-                    g = RadiusGrowth(g.t0, g.taus, np.maximum(g.values - (cut - o.radius + base), 0.0))
-                o = PredictedObstacle(o.name, base, o.motion, g, o.until)
-                self.record.inside_discs = (self.record.inside_discs or 0) + 1
-            out.append(o)
-        return out
-
-    def _split(self, preds: list[PredictedObstacle], p: np.ndarray, t: float
-               ) -> tuple[list[PredictedObstacle], list[PredictedObstacle] | None]:
-        """The predictions planned and timed against from ``p`` at ``t`` [s], and the full
-        ones the safety guard checks (None when every prediction is certain: no guard)."""
-        preds = self._certain(preds)
-        safe = self._planning_preds(preds, p, t)
-        if safe is preds:
-            return preds, None
-        return self._capped(safe), safe
-
-    def _certain(self, preds: list[PredictedObstacle]) -> list[PredictedObstacle]:
-        """With ``guard="growth"``, exact-twist predictions (no uncertain disc: ``twist``
-        perception) are planned against in full, as announced ones (no horizon): measured on
-        DynaBARN, the receding horizon helped only with uncertain discs."""
-        if (self.guard_mode != "growth" or not preds
-                or any(o.growth is not None or o.until == math.inf for o in preds)):
-            return preds
-        return [dataclasses.replace(o, until=math.inf) for o in preds]
-
-    def _guarded_by(self, safe: list[PredictedObstacle]) -> bool:
-        """Whether the safety guard decides what starts: predictions with uncertain discs
-        (``guard="growth"``, tracked perception), any with a horizon (``"horizon"``), or never."""
-        if self.guard_mode == "horizon":
-            return True
-        return self.guard_mode == "growth" and any(o.growth is not None for o in safe)
-
-    def _capped(self, preds: list[PredictedObstacle]) -> list[PredictedObstacle]:
-        """``preds`` with their extra radius capped at ``plan_extra_m`` (what paths are planned
-        and timed against; the safety guard keeps the full growth)."""
-        c = self.plan_extra_m
-        if c is None:
-            return preds
-        return [o if o.growth is None or o.growth.max_extra <= c else
-                PredictedObstacle(o.name, o.radius, o.motion,
-                                  RadiusGrowth(o.growth.t0, o.growth.taus,
-                                               np.minimum(o.growth.values, c)), o.until)
-                for o in preds]
 
     def _guard(self, obs: Observation, t_switch: float, motion: Trajectory | None,
                safe: list[PredictedObstacle], observed: list[PredictedObstacle],
@@ -443,15 +395,21 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         observed = preds
         preds, safe = self._split(preds, np.array([state.x, state.y]), t_ready)
         uncertain = safe is not None
-        self._cands = []
+        # Improving: the motion in use (checked free just before) is the candidate to beat.
+        inc = self.trajectory if reason == IMPROVE and self._path is not None else None
+        self._cands = [] if inc is None else [(inc.t_end, inc, np.asarray(self._path), list(self._shapes))]
+        self._improve_left = self._improve_left - 1 if inc is not None else 0
+        self._cut = False
+        self._floor = self._floor if inc is not None else math.inf
         self._tried = []
         self._preds = list(preds)
         self._rows = None
         self._nominals = {}
         w0 = time.perf_counter()
         self._search_deadline = None if self.search_budget_s is None else w0 + self.search_budget_s
+        self._last_build = None
         res: SequentialResult | None = None
-        if self._path is not None and len(self._path) >= 2:
+        if inc is None and self._path is not None and len(self._path) >= 2:
             # First the path in use, from where the robot will be: no new search if it can be
             # timed within patience_s.
             rest = remaining_path(self._path, np.array([state.x, state.y]))
@@ -476,7 +434,9 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                                    np.asarray(self.spec.goal, dtype=float), preds, t,
                                    self._timed_fn(state, t_ready, self.patience_s,
                                                   first_wait_s=self.max_wait_s if long_bound
-                                                  else None))
+                                                  else None),
+                                   chain=self._chain if inc is not None else ())
+        self._chain = list(res.virtual_obstacles) if self._cut else []
         if not self._cands and self._tried and long_ok:
             # No timing at all: allow long waits on the shortest path (unless the loop gave it
             # them already) and on the last detour.
@@ -487,11 +447,15 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
         path, shapes = res.path, [v.shape for v in res.virtual_obstacles]
         if self._cands:
             _, motion, path, shapes = self._best_candidate()
+            if inc is not None and motion.t_end > inc.t_end - self.lattice_dt_s:
+                motion = inc  # not a lattice step earlier: not worth a new reference
         elif res.collision_free and res.motion is not None and _followable(res.motion):
             motion = res.motion  # type: ignore[assignment]
         wall = time.perf_counter() - w0
         self._record_replan(t, wall, res, reason)
         self.record.st_candidates.append(len(self._cands))
+        if motion is not None and motion is inc:
+            return  # kept (checked free before this call)
         # Late: the computed motion starts in the past. Re-time from the state the robot will
         # really have, on the same path (no new search).
         t_switch, motion = self._take_up(obs, t_ready, wall, d, dt, motion,
@@ -521,6 +485,8 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
             self.pending = (t_switch, fb)
             return
         self._fallback_active = False
+        self._improve_left = ((self._improve_left if inc is not None else self.improve_calls)
+                              if long_bound and motion.t_end - self._floor > self.accept_s else 0)
         self._path, self._shapes = np.asarray(path), list(shapes)
         self.record.st_timed += int(motion.kind.startswith(ST_PREFIX))
         self.record.st_waits_s.append(float(motion.info.get("wait_s", 0.0)))
@@ -570,10 +536,16 @@ class SpaceTimeBITStarAgent(SequentialBITStarAgent):
                 traj, planned if safe is None else safe, t, self.check_period_s + 0.1, reach):
             self._replan(obs, preds, "safety: the motion in use can no longer stop in time")
             return
-        hit = verify(traj, planned, spec.radius, t_from=t,
-                     t_until=min(max(traj.t_end, t) + 1.0, t + _CHECK_HORIZON_S),
+        t_until = min(max(traj.t_end, t) + 1.0, t + _CHECK_HORIZON_S)
+        end = traj.positions(np.array([traj.t_end]))[0]
+        if math.hypot(end[0] - spec.goal[0], end[1] - spec.goal[1]) <= 0.5 * spec.goal_tolerance:
+            # the run is over inside the goal tolerance: checked as planned (_timed_fn)
+            t_until = traj.t_end - self._tail_time(traj)
+        hit = verify(traj, planned, spec.radius, t_from=t, t_until=max(t_until, t),
                      margin=0.5 * self.config.margin)
         if hit is None:
+            if self._improve_left > 0:
+                self._replan(obs, preds, IMPROVE)
             return
         urgent = hit.t - t < self.urgent_s
         if not urgent and not new and t - self._last_replan < self.min_replan_interval_s:

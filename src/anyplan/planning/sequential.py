@@ -273,7 +273,8 @@ class SequentialBITStar:
         planner.solve(rest)
 
     def replan(self, start: np.ndarray, goal: np.ndarray, predictions: Sequence[PredictedObstacle],
-               t_now: float, motion: MotionModel | None = None) -> SequentialResult:
+               t_now: float, motion: MotionModel | None = None,
+               chain: Sequence[VirtualObstacle] = ()) -> SequentialResult:
         """Plan from ``start`` to ``goal`` until the predicted motion is collision-free.
 
         Args:
@@ -282,6 +283,9 @@ class SequentialBITStar:
             predictions: Predicted moving obstacles (absolute times).
             t_now: Time [s] stamped on the virtual obstacles created.
             motion: The motion model for this replanning (default: the constructor's).
+            chain: Virtual obstacles to start with (a chain an earlier replanning left off;
+                they count towards ``max_iterations``); dropped if the start or the goal
+                is no longer clear of them.
         """
         motion_fn = motion or self.motion
         if motion_fn is None:
@@ -289,7 +293,7 @@ class SequentialBITStar:
         cfg = self.config
         start = np.asarray(start, dtype=float)
         goal = np.asarray(goal, dtype=float)
-        squares: list[VirtualObstacle] = []
+        squares: list[VirtualObstacle] = list(chain)
         candidates: list[tuple[np.ndarray, list[Shape]]] = []
         plan_time = motion_time = 0.0
         costs: list[float] = []
@@ -300,26 +304,30 @@ class SequentialBITStar:
             problem = Problem.create(self.obstacles, start, goal, self.robot_radius)
             if not problem.start_valid():
                 return SequentialResult("invalid_start", np.zeros((0, 2)), None, [], 0)
-        planner = BITStar(problem, cfg.bitstar, rng=self.rng)
+        with_squares = problem.with_shapes([s.shape for s in squares]) if squares else problem
+        if squares and not (with_squares.start_valid() and with_squares.goal_valid()):
+            squares, with_squares = [], problem  # the robot moved into one: start afresh
+        first_it = len(squares)
+        planner = BITStar(with_squares, cfg.bitstar, rng=self.rng)
         best: SequentialResult | None = None
         blocked = False
         status = "collision_predicted"
         deadline = time.perf_counter() + cfg.max_time_s
-        for it in range(cfg.max_iterations):
+        for it in range(first_it, max(cfg.max_iterations, first_it + 1)):
             t0 = time.perf_counter()
-            if it > 0 and t0 > deadline:
+            if it > first_it and t0 > deadline:
                 break
             if not cfg.warm_start and it > 0:
                 planner = BITStar(problem.with_shapes([s.shape for s in squares]), cfg.bitstar,
                                   rng=self.rng)
-            self._solve(planner, it == 0)
+            self._solve(planner, not squares)  # a chain taken up: a detour search
             res = planner.result()
             plan_time += time.perf_counter() - t0
             if not res.solved:
                 status = "plan_failed"
                 break
             costs.append(float(res.cost))
-            if it == 0:
+            if it == first_it:
                 history = list(res.history)
             t1 = time.perf_counter()
             shapes = [s.shape for s in squares]

@@ -1,0 +1,107 @@
+"""What ``st-bitstar`` plans against, and what its safety guard checks, from the predictions.
+
+Certain predictions (announced motions; exact twists with ``guard="growth"``) are planned
+against in full. Uncertain ones (tracked: discs that grow with the horizon) are planned and
+timed against discs whose extra radius is capped at ``plan_extra_m``, on a receding horizon,
+while the safety guard checks the full growth (``docs/perception.md``, "st-bitstar when the
+future is unknown"). :class:`PlanningPredictions` is the agent's part that makes these views.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+
+from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
+
+__all__ = ["PlanningPredictions"]
+
+#: Gap [m] a predicted disc that already holds the robot is shrunk to (``_planning_preds``).
+_INSIDE_GAP_M = 0.02
+
+
+class PlanningPredictions:
+    """The views of the predictions an ``st-bitstar`` agent plans with (a mixin: it reads the
+    agent's ``spec``, ``config.margin``, ``guard_mode``, ``plan_extra_m`` and ``record``)."""
+
+    spec: Any
+    config: Any
+    record: Any
+    guard_mode: str
+    plan_extra_m: float | None
+
+    def _planning_preds(self, preds: list[PredictedObstacle], p: np.ndarray,
+                        t: float) -> list[PredictedObstacle]:
+        """The predictions planned against from the robot's position ``p`` at ``t`` [s].
+
+        Unchanged unless some prediction has a horizon (``until``: no announced motion). Then
+        (1) a prediction that cannot come within reach of the robot before its horizon (both at
+        their top speeds) is left out, and (2) a predicted disc that already holds the robot at
+        ``t`` is shrunk to leave it just outside (by ``_INSIDE_GAP_M``): being inside is not the
+        robot's doing, and a motion that leaves the disc must not look colliding at its start
+        (holding still, or going deeper, still does as the disc comes on or grows).
+        """
+        if not preds or all(o.until == math.inf for o in preds):
+            return preds  # the same object: certain predictions
+        r, v, m = self.spec.radius, self.spec.v_max, self.config.margin
+        out = []
+        for o in preds:
+            if o.until < t:
+                continue
+            q = o.positions(np.array([t]))[0]
+            d = float(np.hypot(*(q - p)))
+            if d - (v + o.max_speed) * (o.until - t) - r - m - o.max_radius > 0.0:
+                continue  # out of reach within the horizon
+            gap = d - r - m - float(o.radius_at(t))
+            if gap < _INSIDE_GAP_M:
+                cut = _INSIDE_GAP_M - gap
+                base = max(o.radius - cut, 0.0)
+                g = o.growth
+                if g is not None and cut > o.radius - base:
+                    g = RadiusGrowth(g.t0, g.taus, np.maximum(g.values - (cut - o.radius + base), 0.0))
+                o = PredictedObstacle(o.name, base, o.motion, g, o.until)
+                self.record.inside_discs = (self.record.inside_discs or 0) + 1
+            out.append(o)
+        return out
+
+    def _split(self, preds: list[PredictedObstacle], p: np.ndarray, t: float
+               ) -> tuple[list[PredictedObstacle], list[PredictedObstacle] | None]:
+        """The predictions planned and timed against from ``p`` at ``t`` [s], and the full
+        ones the safety guard checks (None when every prediction is certain: no guard)."""
+        preds = self._certain(preds)
+        safe = self._planning_preds(preds, p, t)
+        if safe is preds:
+            return preds, None
+        return self._capped(safe), safe
+
+    def _certain(self, preds: list[PredictedObstacle]) -> list[PredictedObstacle]:
+        """With ``guard="growth"``, exact-twist predictions (no uncertain disc: ``twist``
+        perception) are planned against in full, as announced ones (no horizon): measured on
+        DynaBARN, the receding horizon helped only with uncertain discs."""
+        if (self.guard_mode != "growth" or not preds
+                or any(o.growth is not None or o.until == math.inf for o in preds)):
+            return preds
+        return [dataclasses.replace(o, until=math.inf) for o in preds]
+
+    def _guarded_by(self, safe: list[PredictedObstacle]) -> bool:
+        """Whether the safety guard decides what starts: predictions with uncertain discs
+        (``guard="growth"``, tracked perception), any with a horizon (``"horizon"``), or never."""
+        if self.guard_mode == "horizon":
+            return True
+        return self.guard_mode == "growth" and any(o.growth is not None for o in safe)
+
+    def _capped(self, preds: list[PredictedObstacle]) -> list[PredictedObstacle]:
+        """``preds`` with their extra radius capped at ``plan_extra_m`` (what paths are planned
+        and timed against; the safety guard keeps the full growth)."""
+        c = self.plan_extra_m
+        if c is None:
+            return preds
+        return [o if o.growth is None or o.growth.max_extra <= c else
+                PredictedObstacle(o.name, o.radius, o.motion,
+                                  RadiusGrowth(o.growth.t0, o.growth.taus,
+                                               np.minimum(o.growth.values, c)), o.until)
+                for o in preds]
+

@@ -1,0 +1,116 @@
+"""st-bitstar's improvement calls: the search the budget cut goes on at the next checks."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from anyplan.agents import AGENTS, make_agent
+from anyplan.simulation import simulate
+from anyplan.world.scenario import scenario_from_dict
+
+_DYNABARN = Path(__file__).resolve().parents[3] / "shared" / "benchmarks" / "dynabarn" / "worlds.json"
+needs_dynabarn = pytest.mark.skipif(not _DYNABARN.is_file(),
+                                    reason="shared DynaBARN worlds.json not present")
+
+
+def _world(i: int):
+    from anyplan.experiments.dynabarn import load_worlds, world_to_scenario
+    from anyplan.simulation.perception import override_sensing
+
+    world = next(w for w in load_worlds(_DYNABARN) if w["world"] == i)
+    return override_sensing(scenario_from_dict(world_to_scenario(world)), "oracle")
+
+
+def _settings(**kw):
+    # deterministic (fixed delay, BIT* on batches), and a budget that lets each replanning
+    # time one path: the first plan its shortest path, each improvement call one detour
+    return {**AGENTS.get("st-bitstar").deterministic_settings, "search_budget_s": 1e-9, **kw}
+
+
+def test_bad_improve_calls():
+    for bad in (-1, 1.5, "3"):
+        with pytest.raises(ValueError, match="improve_calls"):
+            make_agent("st-bitstar", improve_calls=bad)
+
+
+@needs_dynabarn
+@pytest.mark.parametrize("world", [27, 31])
+def test_improvement_calls_take_up_the_chain_and_only_ever_arrive_earlier(world, monkeypatch):
+    # DynaBARN 27 and 31 (motions announced): the first plan stops at its shortest path,
+    # which waits long for the obstacles. The improvement calls go on with the detours where
+    # the budget cut the loop (each starts from the squares the last one left off), replace
+    # the motion in use only by one arriving at least a lattice step earlier, stop after
+    # improve_calls calls per motion taken, and arrive sooner than without them.
+    import anyplan.agents.spacetime as st
+
+    chains: list[tuple[str, list]] = []
+    inner = st.SpaceTimeBITStarAgent._replan
+
+    def spy(self, obs, preds, reason):
+        loop_replan = self.loop.replan
+
+        def traced(*a, **kw):
+            chains.append((reason, list(kw.get("chain", ()))))
+            res = loop_replan(*a, **kw)
+            chains.append(("result", list(res.virtual_obstacles)))
+            return res
+
+        self.loop.replan = traced
+        try:
+            return inner(self, obs, preds, reason)
+        finally:
+            del self.loop.replan
+
+    monkeypatch.setattr(st.SpaceTimeBITStarAgent, "_replan", spy)
+    sc = _world(world)
+    without = make_agent("st-bitstar", **_settings(improve_calls=0))
+    res0 = simulate(sc, without, seed=0)
+    agent = make_agent("st-bitstar", **_settings(improve_calls=3))
+    res = simulate(sc, agent, seed=0)
+    assert res0.reached_goal and res.reached_goal and not res.collision
+    assert without.record.reasons.count(st.IMPROVE) == 0
+    reasons = agent.record.reasons
+    assert reasons[0] == "initial" and st.IMPROVE in reasons
+    # each improvement call starts from the squares of the path the previous call left off
+    calls = [c for c in chains if c[0] != "result"]
+    results = [c for c in chains if c[0] == "result"]
+    for k, (reason, chain) in enumerate(calls):
+        if reason == st.IMPROVE:
+            assert chain == results[k - 1][1] and chain
+    # a new plan from an improvement call arrives at least a lattice step earlier
+    arrivals = [p["arrival_s"] for p in agent.stats.plans]
+    plan_reasons = [reasons[agent.record.replan_times_s.index(p["t"])] for p in agent.stats.plans]
+    for prev, now, why in zip(arrivals, arrivals[1:], plan_reasons[1:], strict=False):
+        if why == st.IMPROVE:
+            assert now <= prev - agent.lattice_dt_s + 1e-9
+    # at most improve_calls improvement calls in a row after a motion is taken
+    run = 0
+    for k, why in enumerate(reasons):
+        run = run + 1 if why == st.IMPROVE else 0
+        assert run <= agent.improve_calls, reasons
+        if why == st.IMPROVE and agent.record.replan_times_s[k] in [p["t"] for p in agent.stats.plans]:
+            run = 0
+    assert len(arrivals) >= 2 and arrivals[-1] < arrivals[0]
+    assert res.time_to_goal_s < res0.time_to_goal_s
+
+
+@needs_dynabarn
+def test_no_improvement_calls_when_the_motion_is_about_as_fast_as_untimed():
+    # DynaBARN 22: the shortest path is free as timed for the static world: nothing to improve
+    agent = make_agent("st-bitstar", **_settings())
+    simulate(_world(22), agent, seed=0)
+    assert agent.record.reasons == ["initial"]
+
+
+@needs_dynabarn
+def test_no_replanning_for_contacts_predicted_once_the_run_is_over():
+    # DynaBARN 41: an obstacle crosses the goal shortly after the robot arrives there. The
+    # motion is planned and checked up to half the goal tolerance (the run ends within it),
+    # so a contact predicted at the goal after that is no reason to replan. Before, the robot
+    # replanned every 0.6 s for it (25 times), in vain.
+    agent = make_agent("st-bitstar", **_settings(improve_calls=0, search_budget_s=None))
+    res = simulate(_world(41), agent, seed=0)
+    assert res.reached_goal and not res.collision
+    assert not [r for r in agent.record.reasons if r.startswith("collision")]
