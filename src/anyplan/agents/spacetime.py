@@ -81,7 +81,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
             replanning that has run this long (wall clock) takes the best candidate instead of
             timing more detours (with certain predictions; None: no budget, as the
             deterministic settings have it). Without a timed path the loop runs on.
-        improve_calls: With certain predictions, when the motion taken arrives more than
+        improve_calls: With announced motions, when the motion taken arrives more than
             ``accept_s`` after the earliest untimed one, the next checks search again (reason
             "improve", each on the budget) with the motion in use as the bound to beat, going
             on with the detours where the budget cut the search; a motion arriving a lattice
@@ -486,7 +486,8 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
             return
         self._fallback_active = False
         self._improve_left = ((self._improve_left if inc is not None else self.improve_calls)
-                              if long_bound and motion.t_end - self._floor > self.accept_s else 0)
+                              if long_bound and all(o.until == math.inf for o in observed)
+                              and motion.t_end - self._floor > self.accept_s else 0)
         self._path, self._shapes = np.asarray(path), list(shapes)
         self.record.st_timed += int(motion.kind.startswith(ST_PREFIX))
         self.record.st_waits_s.append(float(motion.info.get("wait_s", 0.0)))
