@@ -48,7 +48,8 @@ _DEFAULT_LOOP = SequentialConfig(max_iterations=8, wait_delays_s=(), max_time_s=
 _LOOP_FIELDS = frozenset(f.name for f in dataclasses.fields(SequentialConfig))
 #: How far ahead [s] a motion in use is checked (a hold lasts "for ever").
 _CHECK_HORIZON_S = 60.0
-#: The reason of a replanning that goes on with a search the budget cut (``improve_calls``).
+#: The reason of a replanning that looks for a motion earlier than the one in use
+#: (``improve_calls``).
 IMPROVE = "improve"
 #: Row duration [s] of the s-t maps.
 _ROW_H = 0.05
@@ -77,10 +78,12 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
             searched by branch and bound (:meth:`_timed_fn`). When no path can be timed, the
             last path (with uncertain predictions, the first and the last) is timed again with
             waits up to this, and the earlier arrival wins.
-        search_budget_s: Anytime bound of the search for detours [s]: once a path is timed, a
-            replanning that has run this long (wall clock) takes the best candidate instead of
-            timing more detours (with certain predictions; None: no budget, as the
-            deterministic settings have it). Without a timed path the loop runs on.
+        search_budget_s: Anytime bound of the search for detours [s] (wall clock): once a path
+            is timed, a detour is timed only if it can end within this much of the
+            replanning's start (the last path's cost standing for its cost), else the best
+            candidate is taken; each replanning times at least one path (with certain
+            predictions; None: no budget, as the deterministic settings have it). Without a
+            timed path the loop runs on.
         improve_calls: With announced motions, when the motion taken arrives more than
             ``accept_s`` after the earliest untimed one, the next checks search again (reason
             "improve", each on the budget) with the motion in use as the bound to beat, going
