@@ -130,6 +130,39 @@ def test_stacked_rows_are_each_obstacles_rows_and_name_the_blockers():
         assert m.blockers == ["G", "X"]
 
 
+def test_rows_are_shared_by_later_replannings_of_the_same_motions_only():
+    # A RowCache kept across replannings (begin() at each): a new prediction of the same motion
+    # and radius reuses its rows without sampling the motion again, and the rows are the same;
+    # another radius, or a growing disc made anew, gets rows of its own; entries the last
+    # replanning did not use are dropped (predictions made anew each time never come back).
+    calls = []
+
+    class Counted(UnicycleMotion):
+        def positions(self, t):
+            calls.append(len(t))
+            return super().positions(t)
+
+    motion = Counted(5.0, -1.3, np.pi / 2, 0.3)
+    rows = RowCache(0.0, 0.05)
+    rows.begin(1.0)
+    first = rows.rows_all([PredictedObstacle("X", 0.3, motion)], 20, 400)
+    n = len(calls)
+    rows.begin(1.2)
+    again = rows.rows_all([PredictedObstacle("X", 0.3, motion)], 24, 300)
+    assert len(calls) == n  # not sampled again
+    for a, b in zip(first, again, strict=True):
+        assert np.array_equal(a[:, 4:280], b)
+    wider = rows.rows_all([PredictedObstacle("X", 0.5, motion)], 24, 300)
+    assert len(calls) == n + 1 and np.all(wider[2] > again[2])
+    grow = Growing("G", motion, 0.3, 0.02)
+    rows.rows_all([grow], 24, 300)
+    assert len(calls) == n + 2
+    rows.begin(1.4)
+    rows.rows_all([PredictedObstacle("X", 0.5, motion)], 28, 300)
+    rows.begin(1.6)
+    assert len(rows._rows) == 1  # the growing disc's entry is gone, the motion's stays
+
+
 def test_retimed_motion_passes_behind_and_is_certified_free():
     tr = _straight()
     ob = _crossing()

@@ -217,8 +217,10 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         squares), and an earlier one is timed with waits up to T minus its untimed arrival."""
         nominal_fn = self.reference.departing(state, t_start)
         spec, cfg = self.spec, self.config
-        if self._rows is None or self._rows.t_origin != t_start:
-            self._rows = RowCache(t_start, _ROW_H)  # the obstacles' s-t rows, for every candidate
+        if self._rows is None or not self._rows.on_grid(t_start):
+            # the obstacles' s-t rows, for every candidate and every replanning on the grid
+            self._rows = RowCache(t_start, _ROW_H)
+        self._rows.begin(t_start)
 
         def build(path: np.ndarray, shapes: Sequence[Shape], delay: float) -> Trajectory:
             now, last = time.perf_counter(), self._last_build
@@ -406,7 +408,6 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         self._floor = self._floor if inc is not None else math.inf
         self._tried = []
         self._preds = list(preds)
-        self._rows = None
         self._nominals = {}
         w0 = time.perf_counter()
         self._search_deadline = None if self.search_budget_s is None else w0 + self.search_budget_s

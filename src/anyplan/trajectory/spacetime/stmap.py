@@ -76,20 +76,47 @@ def _fill(out: np.ndarray, px: np.ndarray, py: np.ndarray, cx: np.ndarray, cy: n
     return hit
 
 
+def _row_key(o: Any) -> tuple[int, Any, float]:
+    """What an obstacle's rows depend on: a prediction of fixed size (``growth`` None) by its
+    motion and radius (a new prediction of the same announced motion shares its rows), any
+    other by itself. Returns (key, the object the entry holds, radius or nan)."""
+    m = getattr(o, "motion", None)
+    if m is not None and getattr(o, "growth", 0) is None:
+        return id(m), m, float(o.radius)
+    return id(o), o, math.nan
+
+
 class RowCache:
     """The obstacles' centres and largest radii at the rows of one time grid, kept across maps.
 
     Rows are [t_origin + j h, t_origin + (j+1) h] for integers j; a map built with a cache starts
     on this grid (its first row at or before the requested start), so the maps of one
     replanning (the same predictions, the same start) share the obstacles' rows instead of
-    sampling every obstacle again for every candidate path. Entries hold their obstacle, so an
-    ``id`` seen here is the same live object (predictions do not change once made).
+    sampling every obstacle again for every candidate path, and so do later replannings on the
+    same grid for predictions of the same motions (:func:`_row_key`). Entries hold their
+    obstacle or motion, so an ``id`` seen here is the same live object (predictions do not
+    change once made).
     """
 
     def __init__(self, t_origin: float, h: float) -> None:
         self.t_origin, self.h = float(t_origin), float(h)
-        self._rows: dict[int, tuple[Any, int, int, np.ndarray, np.ndarray]] = {}
+        self._rows: dict[int, tuple[Any, int, int, np.ndarray, np.ndarray, float]] = {}
         self._stack: tuple[list[Any], int, int, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._j_begin = 0
+        self._used: set[int] = set()
+
+    def on_grid(self, t: float) -> bool:
+        """Whether time ``t`` [s] is a row boundary of this grid (to 1e-9 of a row)."""
+        x = (float(t) - self.t_origin) / self.h
+        return abs(x - round(x)) < 1e-9
+
+    def begin(self, t: float) -> None:
+        """A new replanning starts at ``t`` [s]: stacks start there (:meth:`rows_all`), and the
+        entries the last replanning did not use are dropped (a prediction made anew each
+        time, e.g. from a twist, never comes back)."""
+        self._j_begin = self.first_row(t)
+        self._rows = {k: e for k, e in self._rows.items() if k in self._used}
+        self._used = set()
 
     def first_row(self, t: float) -> int:
         """Index j of the row that contains time ``t`` [s]."""
@@ -98,21 +125,26 @@ class RowCache:
     def rows(self, o: Any, j0: int, j1: int) -> tuple[np.ndarray, np.ndarray]:
         """Centres (j1 - j0, 2) [m] at the rows' middles and largest radii (j1 - j0,) [m] at
         their ends and middles, rows j0 .. j1 - 1."""
-        e = self._rows.get(id(o))
-        if e is None or e[0] is not o or not (e[1] <= j0 and j1 <= e[2]):
+        key, holder, radius = _row_key(o)
+        self._used.add(key)
+        e = self._rows.get(key)
+        if e is not None and (e[0] is not holder or not (e[5] == radius or math.isnan(radius))):
+            e = None  # not the same motion, or another radius
+        if e is None or not (e[1] <= j0 and j1 <= e[2]):
             # Rows to spare: the next map (a longer path, a longer wait) needs a few more.
-            if e is None or e[0] is not o:
+            if e is None:
                 a, b = j0, j1 + _SPARE_ROWS
-            else:
-                a, b = min(e[1], j0), max(e[2] + (e[2] - e[1]), j1)
+            else:  # (rows before this replanning's start are not kept)
+                a = min(max(e[1], self._j_begin), j0)
+                b = max(e[2] + (e[2] - a), j1)
             j = np.arange(a, b)
             t_mid = self.t_origin + self.h * (j + 0.5)
             t_edges = self.t_origin + self.h * np.arange(a, b + 1)
             q = np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2)
             r_edge = radii_at(o, t_edges)
             r_max = np.maximum(radii_at(o, t_mid), np.maximum(r_edge[:-1], r_edge[1:]))
-            e = (o, a, b, q, r_max)
-            self._rows[id(o)] = e
+            e = (holder, a, b, q, r_max, radius)
+            self._rows[key] = e
         return e[3][j0 - e[1]:j1 - e[1]], e[4][j0 - e[1]:j1 - e[1]]
 
     def rows_all(self, obstacles: Sequence[Any], j0: int, j1: int
@@ -124,16 +156,16 @@ class RowCache:
         same = st is not None and len(st[0]) == len(obstacles) and all(
             x is y for x, y in zip(st[0], obstacles, strict=True))
         if st is None or not same or not (st[1] <= j0 and j1 <= st[2]):
-            # From the grid's origin (the replanning's start: maps start a few rows apart, after
-            # a turn in place or a brake) and with rows to spare (longer paths, longer waits):
+            # From the replanning's start (:meth:`begin`: maps start a few rows apart, after a
+            # turn in place or a brake) and with rows to spare (longer paths, longer waits):
             # every regrowth stacks all the obstacles again.
-            a, b = min(j0, 0), j1 + _SPARE_ROWS
+            a, b = min(j0, self._j_begin), j1 + _SPARE_ROWS
             if st is not None and same:
                 a, b = min(st[1], a), max(st[2], b)
             parts = [self.rows(o, a, b) for o in obstacles]
             # the rows each obstacle's entry holds (rows to spare included) bound the stack
-            lo = max(self._rows[id(o)][1] for o in obstacles)
-            hi = min(self._rows[id(o)][2] for o in obstacles)
+            lo = max(max(self._rows[_row_key(o)[0]][1] for o in obstacles), a)
+            hi = min(self._rows[_row_key(o)[0]][2] for o in obstacles)
             if lo <= a and b <= hi:
                 parts = [self.rows(o, lo, hi) for o in obstacles]
                 a, b = lo, hi
