@@ -231,7 +231,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
             # (and at least one path per replanning: an improving one makes progress)
             if (first_wait_s is not None and shapes and delay == 0.0 and self._cands
                     and self._search_deadline is not None and last is not None
-                    and 2.0 * now - last > self._search_deadline):
+                    and now + (now - last) > self._search_deadline):
                 self.record.st_pruned += 1
                 self._cut = True
                 return self._best_candidate()[1]  # anytime: the best so far

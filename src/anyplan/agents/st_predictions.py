@@ -104,4 +104,3 @@ class PlanningPredictions:
                                   RadiusGrowth(o.growth.t0, o.growth.taus,
                                                np.minimum(o.growth.values, c)), o.until)
                 for o in preds]
-

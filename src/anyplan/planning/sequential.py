@@ -320,7 +320,9 @@ class SequentialBITStar:
             if not cfg.warm_start and it > 0:
                 planner = BITStar(problem.with_shapes([s.shape for s in squares]), cfg.bitstar,
                                   rng=self.rng)
-            self._solve(planner, not squares)  # a chain taken up: a detour search
+            # the first plan's budget for the plan among the static obstacles only (a chain
+            # taken up starts with a detour search)
+            self._solve(planner, not squares)
             res = planner.result()
             plan_time += time.perf_counter() - t0
             if not res.solved:

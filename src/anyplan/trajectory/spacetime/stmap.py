@@ -164,11 +164,11 @@ class RowCache:
                 a, b = min(st[1], a), max(st[2], b)
             parts = [self.rows(o, a, b) for o in obstacles]
             # the rows each obstacle's entry holds (rows to spare included) bound the stack
-            lo = max(max(self._rows[_row_key(o)[0]][1] for o in obstacles), a)
-            hi = min(self._rows[_row_key(o)[0]][2] for o in obstacles)
-            if lo <= a and b <= hi:
-                parts = [self.rows(o, lo, hi) for o in obstacles]
-                a, b = lo, hi
+            held = [self._rows[_row_key(o)[0]] for o in obstacles]
+            hi = min(e[2] for e in held)
+            if all(e[1] <= a for e in held) and b <= hi:
+                parts = [self.rows(o, a, hi) for o in obstacles]
+                b = hi
             q = np.stack([p[0] for p in parts])
             st = (list(obstacles), a, b, np.ascontiguousarray(q[:, :, 0]),
                   np.ascontiguousarray(q[:, :, 1]), np.stack([p[1] for p in parts]))
