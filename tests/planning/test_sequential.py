@@ -158,35 +158,71 @@ def test_a_batch_budget_gives_up_on_an_unreachable_goal_by_work_not_time():
     assert max(t for _, t in out) < 10.0
 
 
-@pytest.mark.parametrize("gap", [False, True])
+@pytest.mark.parametrize("gap", ["none", "open", "narrow"])
 def test_prove_blocked_ends_a_detour_search_that_cannot_succeed(gap):
-    # A wall across paper-1, with a 0.8 m gap or none. A detour search (not the first plan)
-    # with prove_blocked stops after its ordinary budget (2 batches) when the wall provably
-    # separates start and goal, where it otherwise searches 20 x longer; with the gap it finds
-    # the path all the same.
+    # A wall across paper-1: whole, with a 0.8 m gap, or with a gap 1 cm narrower than the
+    # planning disc (finer than any cell of the cover, so only the visibility graph proves it
+    # closed). A detour search (not the first plan) with prove_blocked stops after its
+    # ordinary budget (2 batches) when the cell cover proves the wall separates start and
+    # goal, after five budgets when only the visibility graph does, where it otherwise
+    # searches 20 x longer; with the open gap it finds the path all the same.
     from anyplan.planning.bitstar import BITStar
     from anyplan.planning.problem import Problem
 
     sc = load_scenario("paper-1")
-    wall = ([rectangle((10.0, 3.05), (0.4, 6.1)), rectangle((10.0, 8.95), (0.4, 4.1))] if gap
-            else [rectangle((10.0, 5.5), (0.4, 11.0))])
-    obst = sc.obstacle_set().with_shapes(wall)
     spec = sc.robot
+    r = spec.radius + 0.03
+    width = {"none": 0.0, "open": 0.8, "narrow": 2.0 * r - 0.01}[gap]
+    lo, hi = 6.0 - width / 2.0, 6.0 + width / 2.0
+    wall = [rectangle((10.0, lo / 2.0), (0.4, lo)), rectangle((10.0, (hi + 11.0) / 2.0),
+                                                              (0.4, 11.0 - hi))]
+    obst = sc.obstacle_set().with_shapes(wall)
     batches = {}
     for prove in (False, True):
         cfg = SequentialConfig(batches_per_plan=2, prove_blocked=prove)
-        loop = SequentialBITStar(obst, robot_radius=spec.radius, plan_radius=spec.radius + 0.03,
+        loop = SequentialBITStar(obst, robot_radius=spec.radius, plan_radius=r,
                                  config=cfg, rng=np.random.default_rng(0))
-        problem = Problem.create(obst, spec.start[:2], spec.goal, spec.radius + 0.03)
+        problem = Problem.create(obst, spec.start[:2], spec.goal, r)
         planner = BITStar(problem, cfg.bitstar, rng=loop.rng)
         loop._solve(planner, first=False)
         res = planner.result()
-        assert res.solved == gap
-        if gap:
+        assert res.solved == (gap == "open")
+        if gap == "open":
             assert problem.path_valid(res.path)
         batches[prove] = planner.n_batches
-    if not gap:
+    if gap == "none":
         assert batches[True] <= 3 < 2 * 20 <= batches[False]
+    if gap == "narrow":
+        assert 3 < batches[True] <= 2 + 4 * 2 + 2 < 2 * 20 <= batches[False]
+
+
+def test_a_motion_the_model_verified_is_not_checked_again(monkeypatch):
+    # The loop takes a motion its model reports as verified without its own check; any
+    # other motion is checked as before (and a predicted collision places a square).
+    import anyplan.planning.sequential as seq
+
+    sc = load_scenario("paper-1")
+    loop, preds, _ = _loop(sc, SequentialConfig(batches_per_plan=2))
+    calls = []
+    real = seq.first_collision
+
+    def counting(motion, *args, **kwargs):
+        calls.append(motion)
+        return real(motion, *args, **kwargs)
+
+    monkeypatch.setattr(seq, "first_collision", counting)
+    trusted = []
+
+    def verified(motion):
+        trusted.append(motion)
+        return True
+
+    res = loop.replan(np.array(sc.robot.start[:2]), np.array(sc.robot.goal), preds, 0.0,
+                      verified=verified)
+    assert res.collision_free and res.iterations == 1 and not calls and trusted == [res.motion]
+    res = loop.replan(np.array(sc.robot.start[:2]), np.array(sc.robot.goal), preds, 0.0,
+                      verified=lambda m: False)
+    assert calls and calls[0] is not trusted[0]
 
 
 def test_obstacle_parked_on_the_goal_makes_the_robot_wait_or_report():

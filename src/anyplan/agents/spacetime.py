@@ -293,6 +293,10 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
 
         return build
 
+    def _is_candidate(self, motion: object) -> bool:
+        """True for a timed candidate of this replanning (checked free when it was timed)."""
+        return any(c[1] is motion for c in self._cands)
+
     def _best_candidate(self) -> tuple[float, Trajectory, np.ndarray, list[Shape]]:
         """The timed candidate of this replanning that arrives first (the first among equals)."""
         return min(self._cands, key=lambda c: c[0])
@@ -439,7 +443,8 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
                                    self._timed_fn(state, t_ready, self.patience_s,
                                                   first_wait_s=self.max_wait_s if long_bound
                                                   else None),
-                                   chain=self._chain if inc is not None else ())
+                                   chain=self._chain if inc is not None else (),
+                                   verified=self._is_candidate)
         self._chain = list(res.virtual_obstacles) if self._cut else []
         if not self._cands and self._tried and long_ok:
             # No timing at all: allow long waits on the shortest path (unless the loop gave it

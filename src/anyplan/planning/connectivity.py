@@ -5,9 +5,13 @@ Cover the arena with square cells of side h. A cell whose centre has clearance b
 1-Lipschitz), so it is *blocked*. Any collision-free path passes through a chain of unblocked
 cells, each sharing at least a point with the next (8-neighbours). Hence, if the cells of the
 start and of the goal are not 8-connected through unblocked cells, no collision-free path
-exists: the answer ``True`` is a proof, ``False`` proves nothing. The cost is one pass/fail
-clearance query per cell and a compiled flood fill, whatever the number of obstacles,
-unlike the visibility graph's lower bound (quadratic in the obstacle corners).
+exists: the answer ``True`` is a proof, ``False`` proves nothing. When the cover cannot tell,
+the cells near the obstacles (centre clearance below ``r + h sqrt(2) / 2``: neither blocked nor
+wholly free) are split into finer cells and the fill runs again, so passages narrower than the
+robot by less than the coarse cells' loss (``h sqrt(2) / 2``) are proven closed too, at the
+cost of a fine cover only along the obstacles. The cost is pass/fail
+clearance queries and compiled flood fills, whatever the number of obstacles, unlike the
+visibility graph's lower bound (quadratic in the obstacle corners).
 """
 
 from __future__ import annotations
@@ -18,16 +22,36 @@ import numpy as np
 
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.planning._connectivity_kernels import connected8
+from anyplan.planning.problem import Problem
+from anyplan.planning.visgraph import lower_bound
 
-__all__ = ["provably_disconnected"]
+__all__ = ["exactly_unsolvable", "provably_disconnected"]
 
 #: Most cells of the cover (the cell side grows beyond it).
 MAX_CELLS = 120_000
+#: Most fine cells whose clearance the refinement queries (beyond it, no refinement).
+MAX_REFINED = 400_000
+#: Most polygon corners (a circle counts as :data:`CIRCLE_CORNERS`) for which
+#: :func:`exactly_unsolvable` asks the visibility graph (its cost grows with the square
+#: of the corners: about 6 ms for 16 here).
+MAX_EXACT_CORNERS = 48
+CIRCLE_CORNERS = 8
+
+
+def exactly_unsolvable(problem: Problem) -> bool:
+    """True only if no collision-free path joins the problem's start and goal, by the visibility
+    graph's relaxation (:func:`anyplan.planning.visgraph.lower_bound` infinite), among few
+    obstacles (:data:`MAX_EXACT_CORNERS`; False beyond). Unlike the cell cover it also proves
+    passages closed by less than a cell (a square beside a wall's gap, 2 cm too close)."""
+    arrays = problem.obstacles.arrays
+    if len(arrays.vx) + CIRCLE_CORNERS * len(arrays.circles) > MAX_EXACT_CORNERS:
+        return False
+    return math.isinf(lower_bound(problem))
 
 
 def provably_disconnected(obstacles: ObstacleSet, start: np.ndarray | tuple[float, float],
                           goal: np.ndarray | tuple[float, float], radius: float,
-                          cell: float | None = None) -> bool:
+                          cell: float | None = None, refine: int = 4) -> bool:
     """True only if no collision-free path of the disc robot joins ``start`` and ``goal``.
 
     Args:
@@ -35,27 +59,71 @@ def provably_disconnected(obstacles: ObstacleSet, start: np.ndarray | tuple[floa
         start: Start position (x, y) [m].
         goal: Goal position (x, y) [m].
         radius: Robot radius [m], > 0.
-        cell: Cell side [m]; default max(radius / 2, the side giving :data:`MAX_CELLS` cells).
+        cell: Cell side [m]; default max(radius, the side giving :data:`MAX_CELLS` cells).
+        refine: When the cover proves nothing, split the cells near the obstacles into
+            ``refine`` x ``refine`` finer ones and try again (1: never; at most
+            :data:`MAX_REFINED` fine cells are queried, else no refinement).
     """
     if obstacles.bounds is None or not radius > 0.0:
         return False
     x0, y0, x1, y1 = obstacles.bounds
     w, h_ = x1 - x0, y1 - y0
-    h = cell if cell is not None else max(radius / 2.0, math.sqrt(w * h_ / MAX_CELLS))
-    limit = radius - h * math.sqrt(2.0) / 2.0 - 1e-9
+    h = cell if cell is not None else max(radius, math.sqrt(w * h_ / MAX_CELLS))
+    half = h * math.sqrt(2.0) / 2.0
+    limit = radius - half - 1e-9
     if limit <= 0.0:
         return False  # no cell can be proven blocked
     nx, ny = max(1, math.ceil(w / h)), max(1, math.ceil(h_ / h))
-    xs = x0 + (np.arange(nx) + 0.5) * h
-    ys = y0 + (np.arange(ny) + 0.5) * h
-    gx, gy = np.meshgrid(xs, ys)
-    open_ = obstacles.points_clear(np.column_stack([gx.ravel(), gy.ravel()]), limit)
-    open_ = np.ascontiguousarray(open_.reshape(ny, nx), dtype=np.bool_)
-
-    def cell_of(p: np.ndarray | tuple[float, float]) -> tuple[int, int]:
-        return (min(max(int((p[1] - y0) // h), 0), ny - 1), min(max(int((p[0] - x0) // h), 0), nx - 1))
-
-    (a0, a1), (b0, b1) = cell_of(start), cell_of(goal)
+    centres = _centres(x0, y0, h, nx, ny)
+    # one exact clearance per cell when the set is small; on an indexed map, pass/fail
+    # queries, which stop early, are cheaper even twice
+    dist = None if obstacles.indexed else obstacles.clearances(centres).reshape(ny, nx)
+    open_ = np.ascontiguousarray(dist >= limit if dist is not None else
+                                 obstacles.points_clear(centres, limit).reshape(ny, nx))
+    a, b = _cell_of(start, x0, y0, h, nx, ny), _cell_of(goal, x0, y0, h, nx, ny)
     # a point on a cell border also belongs to the neighbour: only conclude when the
     # endpoints' own cells are open and not joined
-    return bool(open_[a0, a1] and open_[b0, b1] and not connected8(open_, a0, a1, b0, b1))
+    if not (open_[a] and open_[b]):
+        return False
+    if not connected8(open_, a[0], a[1], b[0], b[1]):
+        return True
+    k = int(refine)
+    if k <= 1:
+        return False
+    # the cells neither blocked nor wholly free (centre clearance below radius + half) are
+    # split; on the nested finer grid every cell the coarse cover would block stays blocked
+    free = np.ascontiguousarray(dist >= radius + half if dist is not None else
+                                obstacles.points_clear(centres, radius + half).reshape(ny, nx))
+    wide = free.copy()
+    wide[a] = wide[b] = True
+    if connected8(wide, a[0], a[1], b[0], b[1]):
+        return False  # a chain of wholly free cells joins them: no proof to find
+    near = open_ & ~free
+    n_near = int(np.count_nonzero(near))
+    if n_near == 0 or n_near * k * k > MAX_REFINED:
+        return False
+    hf = h / k
+    fine_limit = radius - hf * math.sqrt(2.0) / 2.0 - 1e-9
+    fine = np.repeat(np.repeat(open_, k, axis=0), k, axis=1)
+    rows, cols = np.nonzero(near)
+    di, dj = np.divmod(np.arange(k * k), k)
+    fi = (rows[:, None] * k + di[None, :]).ravel()
+    fj = (cols[:, None] * k + dj[None, :]).ravel()
+    pts = np.column_stack([x0 + (fj + 0.5) * hf, y0 + (fi + 0.5) * hf])
+    fine[fi, fj] = obstacles.points_clear(pts, fine_limit)
+    fine = np.ascontiguousarray(fine)
+    fa = _cell_of(start, x0, y0, hf, nx * k, ny * k)
+    fb = _cell_of(goal, x0, y0, hf, nx * k, ny * k)
+    return bool(fine[fa] and fine[fb] and not connected8(fine, fa[0], fa[1], fb[0], fb[1]))
+
+
+def _centres(x0: float, y0: float, h: float, nx: int, ny: int) -> np.ndarray:
+    """Centres (nx * ny, 2) of the cells, row by row (y), each row along x."""
+    gx, gy = np.meshgrid(x0 + (np.arange(nx) + 0.5) * h, y0 + (np.arange(ny) + 0.5) * h)
+    return np.column_stack([gx.ravel(), gy.ravel()])
+
+
+def _cell_of(p: np.ndarray | tuple[float, float], x0: float, y0: float, h: float, nx: int,
+             ny: int) -> tuple[int, int]:
+    """(row, column) of the cell holding point ``p``, clamped to the cover."""
+    return (min(max(int((p[1] - y0) // h), 0), ny - 1), min(max(int((p[0] - x0) // h), 0), nx - 1))

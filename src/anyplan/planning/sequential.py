@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any, Protocol
@@ -27,7 +27,7 @@ from anyplan.config import setting, validate
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.geometry.shapes import Shape, square
 from anyplan.planning.bitstar import BITStar, BITStarConfig
-from anyplan.planning.connectivity import provably_disconnected
+from anyplan.planning.connectivity import exactly_unsolvable, provably_disconnected
 from anyplan.planning.problem import Problem
 from anyplan.planning.termination import any_of, batches, first_solution, timed
 from anyplan.prediction.base import PredictedObstacle
@@ -76,7 +76,8 @@ class SequentialConfig:
             returns its best effort (the motion whose first collision is latest).
         prove_blocked: A detour search (after a square) that has no solution after its
             ordinary budget stops at once when the squares provably disconnect start and goal
-            (:func:`~anyplan.planning.connectivity.provably_disconnected`), instead of going on
+            (:func:`~anyplan.planning.connectivity.provably_disconnected`, then
+            :func:`~anyplan.planning.connectivity.exactly_unsolvable`), instead of going on
             for up to 20 budgets in vain; the answer (no path) is the same.
         prediction_dt: The motion is resampled every ``prediction_dt`` seconds for the
             collision prediction (certified: the contact distance is enlarged by the
@@ -258,23 +259,32 @@ class SequentialBITStar:
         if first or not cfg.prove_blocked:
             planner.solve(self._budget(first))
             return
+        # the probe, the cell cover's proof, four more budgets, the visibility graph's proof
+        # (among few obstacles; it also proves passages closed by less than a cell, but costs
+        # more when the squares leave a way), then the rest of the 20 budgets
         if cfg.batches_per_plan is not None:
             n = cfg.batches_per_plan
-            probe, rest = batches(n), any_of(first_solution(), batches(19 * n), timed(10.0))
+            probe, more = batches(n), any_of(first_solution(), batches(4 * n), timed(10.0))
+            rest = any_of(first_solution(), batches(15 * n), timed(10.0))
         else:
             b = cfg.iteration_budget_s
-            probe, rest = timed(b), any_of(first_solution(), timed(19.0 * b))
+            probe, more = timed(b), any_of(first_solution(), timed(4.0 * b))
+            rest = any_of(first_solution(), timed(15.0 * b))
         planner.solve(probe)
         if planner.result().solved:
             return
         p = planner.problem
         if provably_disconnected(p.obstacles, p.start, p.goal, p.radius):
             return
+        planner.solve(more)
+        if planner.result().solved or exactly_unsolvable(p):
+            return
         planner.solve(rest)
 
     def replan(self, start: np.ndarray, goal: np.ndarray, predictions: Sequence[PredictedObstacle],
                t_now: float, motion: MotionModel | None = None,
-               chain: Sequence[VirtualObstacle] = ()) -> SequentialResult:
+               chain: Sequence[VirtualObstacle] = (),
+               verified: Callable[[TimedMotion], bool] | None = None) -> SequentialResult:
         """Plan from ``start`` to ``goal`` until the predicted motion is collision-free.
 
         Args:
@@ -286,6 +296,8 @@ class SequentialBITStar:
             chain: Virtual obstacles to start with (a chain an earlier replanning left off;
                 they count towards ``max_iterations``); dropped if the start or the goal
                 is no longer clear of them.
+            verified: True for a motion of ``motion`` that the model itself has checked free
+                of the predictions: the loop takes it without checking it again.
         """
         motion_fn = motion or self.motion
         if motion_fn is None:
@@ -334,8 +346,9 @@ class SequentialBITStar:
             t1 = time.perf_counter()
             shapes = [s.shape for s in squares]
             timed_motion = motion_fn(res.path, shapes, 0.0)
-            hit = first_collision(timed_motion, predictions, self.robot_radius, margin=cfg.margin,
-                                  sample_dt=cfg.prediction_dt)
+            hit = None if verified is not None and verified(timed_motion) else first_collision(
+                timed_motion, predictions, self.robot_radius, margin=cfg.margin,
+                sample_dt=cfg.prediction_dt)
             motion_time += time.perf_counter() - t1
             candidates.append((res.path, shapes))
             attempt = SequentialResult("collision_free" if hit is None else "collision_predicted",
