@@ -82,3 +82,26 @@ def test_no_proof_where_the_visibility_graph_finds_a_path(seed):
             proved += cover
             assert graph or not cover
     assert found and proved
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_default_cover_proves_all_that_half_radius_cells_prove(seed):
+    # Every cell the half-radius cover blocks stays blocked on the nested finer grid, so the
+    # default (radius cells, refined) proves at least as much, on maps (many boxes) included.
+    from anyplan.geometry.cells import cell_boxes, merge_cells
+
+    rng = np.random.default_rng(seed)
+    old_proofs = 0
+    for _ in range(12):
+        occ = rng.random((24, 32)) < 0.3
+        boxes = cell_boxes(merge_cells(occ), (0.0, 0.0), 0.25)
+        obs = ObstacleSet([], bounds=(0.0, 0.0, 8.0, 6.0), boxes=boxes)
+        free = np.argwhere(~occ)
+        a, b = free[rng.choice(len(free), 2, replace=False)]
+        s, g = (a[1] * 0.25 + 0.125, a[0] * 0.25 + 0.125), (b[1] * 0.25 + 0.125, b[0] * 0.25 + 0.125)
+        r = float(rng.uniform(0.08, 0.12))
+        old = provably_disconnected(obs, s, g, r, cell=r / 2.0, refine=1)
+        old_proofs += old
+        if old:
+            assert provably_disconnected(obs, s, g, r)
+    assert old_proofs

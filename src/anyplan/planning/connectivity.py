@@ -31,6 +31,9 @@ __all__ = ["exactly_unsolvable", "provably_disconnected"]
 MAX_CELLS = 120_000
 #: Most fine cells whose clearance the refinement queries (beyond it, no refinement).
 MAX_REFINED = 400_000
+#: Fine cells the refinement may always query (beyond it and beyond four per coarse cell, the
+#: fine cells are half the coarse side, not a quarter).
+MIN_REFINED = 8192
 #: Most polygon corners (a circle counts as :data:`CIRCLE_CORNERS`) for which
 #: :func:`exactly_unsolvable` asks the visibility graph (its cost grows with the square
 #: of the corners: about 6 ms for 16 here).
@@ -61,8 +64,10 @@ def provably_disconnected(obstacles: ObstacleSet, start: np.ndarray | tuple[floa
         radius: Robot radius [m], > 0.
         cell: Cell side [m]; default max(radius, the side giving :data:`MAX_CELLS` cells).
         refine: When the cover proves nothing, split the cells near the obstacles into
-            ``refine`` x ``refine`` finer ones and try again (1: never; at most
-            :data:`MAX_REFINED` fine cells are queried, else no refinement).
+            ``refine`` x ``refine`` finer ones and try again (1: never). Halved down to 2
+            while that queries more than four fine cells per coarse cell and more than
+            :data:`MIN_REFINED` (along a map's many walls); no refinement beyond
+            :data:`MAX_REFINED` fine cells.
     """
     if obstacles.bounds is None or not radius > 0.0:
         return False
@@ -94,13 +99,15 @@ def provably_disconnected(obstacles: ObstacleSet, start: np.ndarray | tuple[floa
     # split; on the nested finer grid every cell the coarse cover would block stays blocked
     free = np.ascontiguousarray(dist >= radius + half if dist is not None else
                                 obstacles.points_clear(centres, radius + half).reshape(ny, nx))
-    wide = free.copy()
-    wide[a] = wide[b] = True
-    if connected8(wide, a[0], a[1], b[0], b[1]):
-        return False  # a chain of wholly free cells joins them: no proof to find
+    if connected8(free, a[0], a[1], b[0], b[1]):
+        return False  # a chain of wholly free cells joins them: a path exists
     near = open_ & ~free
     n_near = int(np.count_nonzero(near))
-    if n_near == 0 or n_near * k * k > MAX_REFINED:
+    # at most as many fine queries as a cover of half-size cells (4 per cell) would make, or
+    # MIN_REFINED: along many walls (a map) the fine cells are half as wide
+    while k > 2 and n_near * k * k > max(4 * nx * ny, MIN_REFINED):
+        k //= 2
+    if k <= 1 or n_near == 0 or n_near * k * k > MAX_REFINED:
         return False
     hf = h / k
     fine_limit = radius - hf * math.sqrt(2.0) / 2.0 - 1e-9
