@@ -113,11 +113,12 @@ def test_result_fields():
 def test_bad_options():
     with pytest.raises(ValueError, match="patience_s"):
         make_agent("st-bitstar", patience_s=0.0)
-    for bad in (0.0, -1.0, "fast"):
-        with pytest.raises(ValueError, match="search_budget_s"):
-            make_agent("st-bitstar", search_budget_s=bad)
-    assert make_agent("st-bitstar", search_budget_s=None).search_budget_s is None
-    assert AGENTS.get("st-bitstar").deterministic_settings["search_budget_s"] is None
+    for name in ("search_budget_s", "improve_budget_s"):
+        for bad in (0.0, -1.0, "fast"):
+            with pytest.raises(ValueError, match=name):
+                make_agent("st-bitstar", **{name: bad})
+        assert getattr(make_agent("st-bitstar", **{name: None}), name) is None
+        assert AGENTS.get("st-bitstar").deterministic_settings[name] is None
 
 
 @pytest.mark.slow

@@ -26,7 +26,8 @@ def _world(i: int):
 def _settings(**kw):
     # deterministic (fixed delay, BIT* on batches), and a budget that lets each replanning
     # time one path: the first plan its shortest path, each improvement call one detour
-    return {**AGENTS.get("st-bitstar").deterministic_settings, "search_budget_s": 1e-9, **kw}
+    return {**AGENTS.get("st-bitstar").deterministic_settings, "search_budget_s": 1e-9,
+            "improve_budget_s": 1e-9, **kw}
 
 
 def test_bad_improve_calls():
@@ -128,3 +129,30 @@ def test_no_improvement_calls_without_announced_motions():
     simulate(override_sensing(_world(27), "twist"), agent, seed=0)
     assert agent.record.reasons[0] == "initial"
     assert "improve" not in agent.record.reasons
+
+
+@needs_dynabarn
+def test_improvement_calls_search_on_their_own_budget(monkeypatch):
+    # DynaBARN 31: with no budget for replannings and the least one for improvement calls,
+    # the first plan tries every path of the loop and each improvement call exactly one (the
+    # robot has a safe motion already); without an improvement budget they try more.
+    import anyplan.agents.spacetime as st
+
+    inner = st.SpaceTimeBITStarAgent._replan
+    tried: list[tuple[str, int]] = []
+
+    def spy(self, obs, preds, reason):
+        out = inner(self, obs, preds, reason)
+        tried.append((reason, len(self._tried)))
+        return out
+
+    monkeypatch.setattr(st.SpaceTimeBITStarAgent, "_replan", spy)
+    counts = {}
+    for budget in (1e-9, None):
+        tried.clear()
+        simulate(_world(31), make_agent("st-bitstar", **_settings(search_budget_s=None,
+                                                                 improve_budget_s=budget)), seed=0)
+        assert tried[0][0] == "initial" and tried[0][1] > 1
+        counts[budget] = [n for why, n in tried if why == st.IMPROVE]
+    assert counts[1e-9] and all(n == 1 for n in counts[1e-9])
+    assert max(counts[None]) > 1

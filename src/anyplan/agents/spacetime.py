@@ -86,9 +86,11 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
             timed path the loop runs on.
         improve_calls: With announced motions, when the motion taken arrives more than
             ``accept_s`` after the earliest untimed one, the next checks search again (reason
-            "improve", each on the budget) with the motion in use as the bound to beat, going
+            "improve", each on ``improve_budget_s``) with the motion in use as the bound to beat, going
             on with the detours where the budget cut the search; a motion arriving a lattice
             step earlier replaces it. At most this many calls per motion taken (0: never).
+        improve_budget_s: ``search_budget_s`` of an improvement call [s] (the robot has a
+            safe motion already: about one path per call; None: no budget).
         lattice_dt_s: Approximate step [s] of the velocity lattice.
         horizon_s: Horizon [s] of a prediction extrapolated from the current twist (perception
             ``twist`` or ``tracked``: no announced motion), at least the robot's
@@ -122,7 +124,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
     #: predictions are certain; False times every path of the loop within ``patience_s``.
     branch_and_bound = True
     deterministic_settings = {**SequentialBITStarAgent.deterministic_settings,  # noqa: RUF012
-                              "search_budget_s": None}
+                              "search_budget_s": None, "improve_budget_s": None}
     config_classes = (_DEFAULT_LOOP,)  # its defaults, for the listing of settings
     record: SpaceTimeStats
 
@@ -132,7 +134,8 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
                  guard: str = "growth", manoeuvre_accel: float = 0.0,
                  passive_safety: bool = False, reach_extra_mps: float = 0.3,
                  reach_min_speed_mps: float = 0.0, search_budget_s: float | None = 0.02,
-                 improve_calls: int = 5, **kwargs: Any) -> None:
+                 improve_calls: int = 5, improve_budget_s: float | None = 0.01,
+                 **kwargs: Any) -> None:
         loop = {k: kwargs.pop(k) for k in list(kwargs) if k in _LOOP_FIELDS}  # e.g. from --set
         if config is None:
             config = dataclasses.replace(_DEFAULT_LOOP, **loop)
@@ -168,10 +171,12 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         if not (isinstance(accept_s, int | float) and 0.0 <= accept_s <= patience_s):
             raise ValueError(f"accept_s: must be in [0, patience_s], got {accept_s!r}")
         self.accept_s = float(accept_s)
-        if search_budget_s is not None and not (isinstance(search_budget_s, int | float)
-                                                and search_budget_s > 0.0):
-            raise ValueError(f"search_budget_s: must be > 0 or null, got {search_budget_s!r}")
+        for name, limit in (("search_budget_s", search_budget_s),
+                            ("improve_budget_s", improve_budget_s)):
+            if limit is not None and not (isinstance(limit, int | float) and limit > 0.0):
+                raise ValueError(f"{name}: must be > 0 or null, got {limit!r}")
         self.search_budget_s = None if search_budget_s is None else float(search_budget_s)
+        self.improve_budget_s = None if improve_budget_s is None else float(improve_budget_s)
         self._search_deadline: float | None = None
         self._last_build: float | None = None  # wall clock [s] of the last path built
         if not (isinstance(improve_calls, int) and improve_calls >= 0):
@@ -414,7 +419,8 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         self._preds = list(preds)
         self._nominals = {}
         w0 = time.perf_counter()
-        self._search_deadline = None if self.search_budget_s is None else w0 + self.search_budget_s
+        budget = self.search_budget_s if inc is None else self.improve_budget_s
+        self._search_deadline = None if budget is None else w0 + budget
         self._last_build = None
         res: SequentialResult | None = None
         if inc is None and self._path is not None and len(self._path) >= 2:

@@ -15,7 +15,8 @@ SET_HELP = ("agent setting, e.g. --set planning_delay=0.1 (repeatable; VALUE is 
             "0.1, 2, true, null, measured; 'anyplan planners --settings' lists the keys)")
 DET_HELP = ("same result for the same seed on any machine: for seq-bitstar a fixed planning delay "
             "(planning_delay=0.1), a batch budget (batches_per_plan=2) instead of a time budget and "
-            "max_time_s=10, for st-bitstar also no search budget (search_budget_s=null); --set "
+            "max_time_s=10, for st-bitstar also no search budgets (search_budget_s=null, "
+            "improve_budget_s=null); --set "
             "overrides any of them")
 
 
