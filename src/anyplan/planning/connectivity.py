@@ -9,9 +9,9 @@ exists: the answer ``True`` is a proof, ``False`` proves nothing. When the cover
 the cells near the obstacles (centre clearance below ``r + h sqrt(2) / 2``: neither blocked nor
 wholly free) are split into finer cells and the fill runs again, so passages narrower than the
 robot by less than the coarse cells' loss (``h sqrt(2) / 2``) are proven closed too, at the
-cost of a fine cover only along the obstacles. The cost is pass/fail
-clearance queries and compiled flood fills, whatever the number of obstacles, unlike the
-visibility graph's lower bound (quadratic in the obstacle corners).
+cost of a fine cover only along the obstacles. The cost is clearance queries and compiled
+flood fills, whatever the number of obstacles, unlike the visibility graph's lower bound
+(quadratic in the obstacle corners).
 """
 
 from __future__ import annotations
