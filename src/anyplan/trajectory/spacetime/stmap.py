@@ -24,6 +24,7 @@ __all__ = ["STMap", "RowCache", "build_stmap", "radii_at"]
 
 _CHUNK = 16  # path cells per bounding circle of the coarse test
 _BLOCK = 16  # map rows per block of the coarse test
+_GROUP = 8  # chunks per group of the coarsest test
 _SPARE_ROWS = 200  # rows a RowCache computes beyond the first request
 
 
@@ -39,13 +40,17 @@ def radii_at(obstacle: Any, t: np.ndarray) -> np.ndarray:
 @njit(cache=True)
 def _fill(out: np.ndarray, px: np.ndarray, py: np.ndarray, cx: np.ndarray, cy: np.ndarray,
           crad: np.ndarray, qx: np.ndarray, qy: np.ndarray, reach: np.ndarray, spread: np.ndarray,
-          chunk: int, n_free: int) -> np.ndarray:
+          chunk: int, n_free: int, sx: np.ndarray, sy: np.ndarray, srad: np.ndarray,
+          group: int) -> np.ndarray:
     """Mark the cells (j, c) with |P_c - Q_oj| <= reach_oj for every obstacle o (rows of q, reach);
     cells c >= n_free stay free; ``spread[o]`` bounds how far [m] obstacle o moves per row (blocks
-    of rows far from a chunk of cells are skipped at once). Returns, per obstacle, whether it
-    marked a cell."""
+    of rows far from a chunk of cells are skipped at once, and far from a group of ``group``
+    chunks, bounded by the circles ``sx, sy, srad``, all its chunks at once). Returns, per
+    obstacle, whether it marked a cell. The skips compare squared distances with 1e-9 m to
+    spare: they only leave out cells the exact test would not mark."""
     nrow = out.shape[0]
     ncell = min(out.shape[1], n_free)
+    nchunk = cx.shape[0]
     hit = np.zeros(qx.shape[0], dtype=np.bool_)
     nb = (nrow + _BLOCK - 1) // _BLOCK
     for o in range(qx.shape[0]):
@@ -56,23 +61,33 @@ def _fill(out: np.ndarray, px: np.ndarray, py: np.ndarray, cx: np.ndarray, cy: n
             rb = 0.0
             for j in range(j0, j1):
                 rb = max(rb, reach[o, j])
-            rb += spread[o] * max(jm - j0, j1 - 1 - jm)
-            for g in range(cx.shape[0]):
-                if math.hypot(qx[o, jm] - cx[g], qy[o, jm] - cy[g]) - crad[g] > rb:
+            rb += spread[o] * max(jm - j0, j1 - 1 - jm) + 1e-9
+            xm, ym = qx[o, jm], qy[o, jm]
+            for k in range(sx.shape[0]):
+                dx, dy = xm - sx[k], ym - sy[k]
+                lim = rb + srad[k]
+                if dx * dx + dy * dy > lim * lim:
                     continue
-                c1 = min((g + 1) * chunk, ncell)
-                for j in range(j0, j1):
-                    r = reach[o, j]
-                    x, y = qx[o, j], qy[o, j]
-                    if math.hypot(x - cx[g], y - cy[g]) - crad[g] > r:
+                for g in range(k * group, min((k + 1) * group, nchunk)):
+                    dx, dy = xm - cx[g], ym - cy[g]
+                    lim = rb + crad[g]
+                    if dx * dx + dy * dy > lim * lim:
                         continue
-                    r2 = r * r
-                    for c in range(g * chunk, c1):
-                        dx = px[c] - x
-                        dy = py[c] - y
-                        if dx * dx + dy * dy <= r2:
-                            out[j, c] = True
-                            hit[o] = True
+                    c1 = min((g + 1) * chunk, ncell)
+                    for j in range(j0, j1):
+                        r = reach[o, j]
+                        x, y = qx[o, j], qy[o, j]
+                        dx, dy = x - cx[g], y - cy[g]
+                        lim = r + crad[g] + 1e-9
+                        if dx * dx + dy * dy > lim * lim:
+                            continue
+                        r2 = r * r
+                        for c in range(g * chunk, c1):
+                            dx = px[c] - x
+                            dy = py[c] - y
+                            if dx * dx + dy * dy <= r2:
+                                out[j, c] = True
+                                hit[o] = True
     return hit
 
 
@@ -242,6 +257,14 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     cxs, cys = gxs.reshape(ng, _CHUNK), gys.reshape(ng, _CHUNK)
     cx, cy = np.nanmean(cxs, axis=1), np.nanmean(cys, axis=1)
     crad = np.nanmax(np.hypot(cxs - cx[:, None], cys - cy[:, None]), axis=1)
+    # groups of _GROUP chunks, each bounded by a circle around all its points
+    ns = int(math.ceil(ng / _GROUP))
+    spad = np.full(ns * _GROUP * _CHUNK, np.nan)
+    sxf, syf = spad.copy(), spad.copy()
+    sxf[:ncell], syf[:ncell] = px, py
+    sxs, sys_ = sxf.reshape(ns, -1), syf.reshape(ns, -1)
+    sx, sy = np.nanmean(sxs, axis=1), np.nanmean(sys_, axis=1)
+    srad = np.nanmax(np.hypot(sxs - sx[:, None], sys_ - sy[:, None]), axis=1)
     n_free = int(math.floor(max(length - free_tail_m, 0.0) / ds)) if free_tail_m > 0.0 else ncell
     gx, gy = float(px.mean()), float(py.mean())
     grad = float(np.max(np.hypot(px - gx, py - gy)))
@@ -267,6 +290,6 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     if len(near):
         hit = _fill(out, px, py, cx, cy, crad, np.ascontiguousarray(qx[near]),
                     np.ascontiguousarray(qy[near]), np.ascontiguousarray(reach[near]),
-                    speed[near] * h, _CHUNK, n_free)
+                    speed[near] * h, _CHUNK, n_free, sx, sy, srad, _GROUP)
         blockers = [str(obstacles[k].name) for k, hh in zip(near, hit, strict=True) if hh]
     return STMap(out, t_map, h, ds, length, blockers)
