@@ -21,13 +21,17 @@ R = 0.33
 START, GOAL = (1.5, 3.0), (10.5, 3.5)
 
 
+def _wall():
+    """A wall at x = 6 (faces at 5.9 and 6.1) with a gap at y 2.2 .. 3.7."""
+    return [rectangle((6.0, 1.1), (0.2, 2.2)), rectangle((6.0, 5.85), (0.2, 4.3))]
+
+
 def _gap_and_square(dx: float, dy: float) -> ObstacleSet:
-    """A wall at x = 6 with a gap (y 2.2 .. 3.7) and a 1.2 m square just behind the gap, at
-    ``dx`` from the wall's face and ``dy`` above the gap's lower edge (the square's corner)."""
-    wall = [rectangle((6.0, 1.1), (0.2, 2.2)), rectangle((6.0, 5.85), (0.2, 4.3))]
+    """:func:`_wall` and a 1.2 m square just behind the gap, at ``dx`` from the wall's face
+    and ``dy`` above the gap's lower edge (the square's corner)."""
     x0, y0 = 6.1 + dx, 2.2 + dy
     square = Polygon(np.array([[x0, y0], [x0 + 1.2, y0], [x0 + 1.2, y0 + 1.2], [x0, y0 + 1.2]]))
-    return ObstacleSet([*wall, square], bounds=(0.0, 0.0, 12.0, 8.0))
+    return ObstacleSet([*_wall(), square], bounds=(0.0, 0.0, 12.0, 8.0))
 
 
 def test_the_refinement_proves_a_passage_the_coarse_cover_cannot():
@@ -41,16 +45,14 @@ def test_the_refinement_proves_a_passage_the_coarse_cover_cannot():
 
 def test_the_visibility_graph_proves_what_no_cell_can():
     # 2 cm narrower than the robot: finer than the refined cells, exact for the visibility graph.
-    d = 2.0 * R - 0.02
-    obs = ObstacleSet([rectangle((6.0, 1.1), (0.2, 2.2)), rectangle((6.0, 5.85), (0.2, 4.3)),
-                       rectangle((6.1 + d + 0.6, 2.95), (1.2, 4.0))], bounds=(0.0, 0.0, 12.0, 8.0))
-    problem = Problem.create(obs, START, GOAL, R)
+    def behind(d: float) -> ObstacleSet:  # a block whose face stands d from the wall's
+        return ObstacleSet([*_wall(), rectangle((6.1 + d + 0.6, 2.95), (1.2, 4.0))],
+                           bounds=(0.0, 0.0, 12.0, 8.0))
+
+    obs = behind(2.0 * R - 0.02)
     assert not provably_disconnected(obs, START, GOAL, R)
-    assert exactly_unsolvable(problem)
-    wide = ObstacleSet([rectangle((6.0, 1.1), (0.2, 2.2)), rectangle((6.0, 5.85), (0.2, 4.3)),
-                        rectangle((6.1 + 2.0 * R + 0.02 + 0.6, 2.95), (1.2, 4.0))],
-                       bounds=(0.0, 0.0, 12.0, 8.0))
-    assert not exactly_unsolvable(Problem.create(wide, START, GOAL, R))
+    assert exactly_unsolvable(Problem.create(obs, START, GOAL, R))
+    assert not exactly_unsolvable(Problem.create(behind(2.0 * R + 0.02), START, GOAL, R))
 
 
 def test_the_visibility_graph_is_not_asked_among_many_obstacles():

@@ -91,6 +91,19 @@ def _fill(out: np.ndarray, px: np.ndarray, py: np.ndarray, cx: np.ndarray, cy: n
     return hit
 
 
+def _bounding_circles(px: np.ndarray, py: np.ndarray, size: int
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Centre (x, y) and radius [m] of a circle around each run of ``size`` consecutive path
+    points (the last run may be shorter): the mean point, and the largest distance to it."""
+    n = len(px)
+    runs = int(math.ceil(n / size))
+    flat_x, flat_y = np.full(runs * size, np.nan), np.full(runs * size, np.nan)
+    flat_x[:n], flat_y[:n] = px, py
+    xs, ys = flat_x.reshape(runs, size), flat_y.reshape(runs, size)
+    cx, cy = np.nanmean(xs, axis=1), np.nanmean(ys, axis=1)
+    return cx, cy, np.nanmax(np.hypot(xs - cx[:, None], ys - cy[:, None]), axis=1)
+
+
 def _row_key(o: Any) -> tuple[int, Any, float]:
     """What an obstacle's rows depend on: a prediction of fixed size (``growth`` None) by its
     motion and radius (a new prediction of the same announced motion shares its rows), any
@@ -250,21 +263,8 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     sc = np.minimum((np.arange(ncell) + 0.5) * ds, length)
     p = np.asarray(points_at(sc), dtype=float).reshape(-1, 2)
     px, py = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
-    ng = int(math.ceil(ncell / _CHUNK))
-    pad = np.full(ng * _CHUNK, np.nan)
-    gxs, gys = pad.copy(), pad.copy()
-    gxs[:ncell], gys[:ncell] = px, py
-    cxs, cys = gxs.reshape(ng, _CHUNK), gys.reshape(ng, _CHUNK)
-    cx, cy = np.nanmean(cxs, axis=1), np.nanmean(cys, axis=1)
-    crad = np.nanmax(np.hypot(cxs - cx[:, None], cys - cy[:, None]), axis=1)
-    # groups of _GROUP chunks, each bounded by a circle around all its points
-    ns = int(math.ceil(ng / _GROUP))
-    spad = np.full(ns * _GROUP * _CHUNK, np.nan)
-    sxf, syf = spad.copy(), spad.copy()
-    sxf[:ncell], syf[:ncell] = px, py
-    sxs, sys_ = sxf.reshape(ns, -1), syf.reshape(ns, -1)
-    sx, sy = np.nanmean(sxs, axis=1), np.nanmean(sys_, axis=1)
-    srad = np.nanmax(np.hypot(sxs - sx[:, None], sys_ - sy[:, None]), axis=1)
+    cx, cy, crad = _bounding_circles(px, py, _CHUNK)
+    sx, sy, srad = _bounding_circles(px, py, _GROUP * _CHUNK)  # groups of _GROUP chunks
     n_free = int(math.floor(max(length - free_tail_m, 0.0) / ds)) if free_tail_m > 0.0 else ncell
     gx, gy = float(px.mean()), float(py.mean())
     grad = float(np.max(np.hypot(px - gx, py - gy)))
