@@ -19,11 +19,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from anyplan.errors import AnyplanError
 from anyplan.experiments import dynabarn
 from anyplan.world.scenario import Scenario, scenario_from_dict
+from anyplan.world.yaml_load import dump_yaml
 
 __all__ = ["JACKAL", "SHIFT", "ARENA", "START", "GOAL", "TIME_LIMIT", "N_WORLDS", "INDEX_FILE",
            "BARNError", "Feasibility", "default_source", "load_worlds", "parse_worlds",
@@ -234,7 +233,7 @@ def convert(source: str | Path, out_dir: str | Path, worlds: Sequence[int] | str
                   "# Challenge repository data, MIT licence, Copyright (c) 2022 Zifan Xu.\n"
                   "# Frame: BARN (x + 4.5, y) m. See anyplan.experiments.barn.\n"
                   f"# Challenge reference path length: {ref:g} m (optimal time {ref / 2.0:g} s).\n")
-        p.write_text(header + yaml.safe_dump(sc, sort_keys=False, default_flow_style=None, width=100))
+        p.write_text(header + dump_yaml(sc, sort_keys=False, default_flow_style=None, width=100))
         entry: dict[str, Any] = {"world": i, "reference_path_length_m": ref,
                                  "optimal_time_s": ref / 2.0,
                                  "cylinders": len(by_index[i]["cylinders"]),

@@ -20,10 +20,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from anyplan.errors import AnyplanError
 from anyplan.world.scenario import scenario_from_dict
+from anyplan.world.yaml_load import dump_yaml
 
 __all__ = ["CrowdError", "CrowdOptions", "SERVICE_ROBOT", "PERSON_RADIUS", "FRAME_RATE",
            "read_obsmat", "crowd_scenarios", "import_crowd"]
@@ -248,6 +248,6 @@ def import_crowd(path: str | Path, out_dir: str | Path, options: CrowdOptions | 
     for sc in scenarios:
         f = out / f"{sc['name']}.yaml"
         f.write_text(f"# Converted by 'anyplan import-crowd' from {p.name} (ETH/UCY obsmat).\n"
-                     + yaml.safe_dump(sc, sort_keys=False, default_flow_style=None, width=100))
+                     + dump_yaml(sc, sort_keys=False, default_flow_style=None, width=100))
         paths.append(f)
     return paths

@@ -20,10 +20,9 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from anyplan.errors import AnyplanError
 from anyplan.world.scenario import scenario_from_dict
+from anyplan.world.yaml_load import dump_yaml
 
 __all__ = ["JACKAL", "SHIFT", "ARENA", "DynaBARNError", "default_worlds_path", "load_worlds",
            "parse_worlds", "world_to_scenario", "convert", "tier"]
@@ -204,6 +203,6 @@ def convert(worlds_file: str | Path, out_dir: str | Path, worlds: Sequence[int] 
                   "# BARN Challenge repository data, MIT licence, Copyright (c) 2022 Zifan Xu.\n"
                   "# Frame: DynaBARN (x, y) + (10.5, 10.5) m. See anyplan.experiments.dynabarn.\n"
                   f"# Obstacles (DynaBARN plugin names): {names}\n")
-        p.write_text(header + yaml.safe_dump(sc, sort_keys=False, default_flow_style=None, width=100))
+        p.write_text(header + dump_yaml(sc, sort_keys=False, default_flow_style=None, width=100))
         paths.append(p)
     return paths

@@ -20,7 +20,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
+
+from anyplan.world.yaml_load import dump_yaml
 
 __all__ = ["FloorPlan", "office", "warehouse", "roughen", "write_map", "map_scenario", "walkers"]
 
@@ -194,7 +195,7 @@ def write_map(plan: FloorPlan, stem: str | Path) -> Path:
     meta = {"image": pgm.name, "resolution": plan.resolution, "origin": [0.0, 0.0, 0.0],
             "negate": 0, "occupied_thresh": 0.65, "free_thresh": 0.196}
     out = stem.with_suffix(".yaml")
-    out.write_text(yaml.safe_dump(meta, sort_keys=False))
+    out.write_text(dump_yaml(meta, sort_keys=False))
     return out
 
 
@@ -248,5 +249,5 @@ def map_scenario(plan: FloorPlan, directory: str | Path, name: str, *,
     if n_walkers:
         data["dynamic_obstacles"] = walkers(plan, n_walkers, rng=rng)
     out = d / f"{name}.yaml"
-    out.write_text(yaml.safe_dump(data, sort_keys=False))
+    out.write_text(dump_yaml(data, sort_keys=False))
     return out

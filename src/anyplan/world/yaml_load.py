@@ -21,7 +21,7 @@ from typing import Any
 import yaml
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
-__all__ = ["YamlLimitError", "load_yaml", "MAX_DOCUMENT_CHARS", "MAX_DEPTH", "MAX_NODES",
+__all__ = ["YamlLimitError", "load_yaml", "dump_yaml", "MAX_DOCUMENT_CHARS", "MAX_DEPTH", "MAX_NODES",
            "MAX_SCALAR_CHARS"]
 
 #: Largest document [characters].
@@ -136,9 +136,29 @@ def _expanded_size(root: Node) -> int:
 
 
 # YAML 1.1 reads ``1e6`` (no dot) as text; read it as a number, as YAML 1.2 and JSON do.
-_StrictLoader.add_implicit_resolver(
-    "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
-    list("-+0123456789"))
+_EXP_FLOAT = re.compile(r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$")
+_StrictLoader.add_implicit_resolver("tag:yaml.org,2002:float", _EXP_FLOAT, list("-+0123456789"))
+
+
+class _Dumper(yaml.SafeDumper):
+    """``yaml.SafeDumper`` that quotes the strings :func:`load_yaml` would read as numbers."""
+
+    def choose_scalar_style(self) -> str:
+        # PyYAML writes a NEL (U+0085) raw in a single-quoted scalar with allow_unicode, and
+        # reads it back as a folded space; double quotes escape it (\N).
+        if "\x85" in getattr(self.event, "value", ""):
+            return '"'
+        return str(super().choose_scalar_style())
+
+
+# the dumper quotes a string when its own resolvers would read the plain scalar as another type
+_Dumper.add_implicit_resolver("tag:yaml.org,2002:float", _EXP_FLOAT, list("-+0123456789"))
+
+
+def dump_yaml(data: Any, **kwargs: Any) -> str:
+    """``yaml.safe_dump(data, **kwargs)`` whose text :func:`load_yaml` reads back as ``data``:
+    a string such as ``"1e5"``, which plain YAML 1.1 writes unquoted, is quoted."""
+    return str(yaml.dump(data, Dumper=_Dumper, **kwargs))
 
 
 _CComposer: type[yaml.CSafeLoader] | None = None
