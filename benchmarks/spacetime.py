@@ -13,8 +13,8 @@ robot's velocity has a component > 0.05 m/s towards the obstacle), time to goal 
 lower bound (the result's ``time_lower_bound_s`` when present, otherwise the same bound computed
 here: from rest under v_max and a_max along the visibility-graph shortest path to the edge of the
 goal tolerance), path length, and planning time per call (median and p95 over all calls; the
-number of calls, and the median of the first plans from rest apart: st-bitstar's improvement
-calls, each on its budget, go on with a search the first plan's budget cut).
+number of calls, the same without st-bitstar's improvement calls (each on its own budget, made
+while the robot already drives a safe motion), and the median of the first plans from rest).
 
 st-bitstar and seq-bitstar run with a **fixed planning delay** of ``--delay`` seconds (0.1 by
 default): the new motion starts that long after the replanning decision whatever the computation
@@ -135,10 +135,13 @@ def run_one(job: tuple[str, int, str, int, dict[str, Any]]) -> dict[str, Any]:
     res = simulate(sc, make_agent(planner, **kw), seed=seed)
     d = res.to_dict()
     lb = d.get("time_lower_bound_s") or lower_bound(sc)
+    reasons = list(res.extra.get("reasons", []))
+    improving = ([r == "improve" for r in reasons] if len(reasons) == len(res.planning_times_s)
+                 else [False] * len(res.planning_times_s))
     return {"suite": suite, "scenario": sc.name, "planner": planner, "seed": seed,
             "status": res.status, "collision": res.collision, "robot_caused": robot_caused(res, sc),
             "time_to_goal": res.time_to_goal_s, "lower_bound": lb, "length": res.path_length_m,
-            "plan_times": list(res.planning_times_s),
+            "plan_times": list(res.planning_times_s), "improving": improving,
             "fallbacks": len(res.extra.get("fallbacks", [])), "wall": time.perf_counter() - t0}
 
 
@@ -166,8 +169,12 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
                 "robot_caused": 0, "ratio_med": float(np.median(ratio)) if ratio else math.nan,
                 "len": float(np.mean([r["path_length_m"] for r in ok])) if ok else math.nan,
                 "pt_med": float(np.median([r["solve_time_s"] for r in rows])) * 1e3,
-                "pt_p95": math.nan, "pt_first_med": math.nan, "calls": 0, "fallbacks": 0}
+                "pt_p95": math.nan, "pt_first_med": math.nan, "calls": 0, "fallbacks": 0,
+                "pt_own_med": math.nan, "pt_own_p95": math.nan, "calls_own": 0}
     pt = np.array([t for r in rows for t in r["plan_times"]]) * 1e3
+    # without st-bitstar's improvement calls (made while the robot has a safe motion already)
+    pt_own = np.array([t for r in rows for t, imp in zip(r["plan_times"], r["improving"],
+                                                         strict=True) if not imp]) * 1e3
     ok = [r for r in rows if r["status"] == "reached"]
     ratio = [r["time_to_goal"] / r["lower_bound"] for r in ok]
     return {"runs": len(rows), "success": len(ok) / len(rows),
@@ -180,6 +187,9 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
             "pt_first_med": float(np.median([r["plan_times"][0] for r in rows if r["plan_times"]]))
             * 1e3 if any(r["plan_times"] for r in rows) else math.nan,
             "calls": int(len(pt)),
+            "pt_own_med": float(np.median(pt_own)) if len(pt_own) else math.nan,
+            "pt_own_p95": float(np.percentile(pt_own, 95)) if len(pt_own) else math.nan,
+            "calls_own": int(len(pt_own)),
             "fallbacks": int(sum(r["fallbacks"] for r in rows))}
 
 
@@ -246,13 +256,15 @@ def main(argv: list[str] | None = None) -> int:
         groups.setdefault((r["suite"], r["planner"]), []).append(r)
     summary = {f"{s}/{p}": summarise(g) for (s, p), g in groups.items()}
     print("\n| suite | planner | runs | success | collisions | robot-caused | time / bound (median) "
-          "| path m | plan ms median | plan ms p95 | calls | first plan ms median | fallbacks |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "| path m | plan ms median | plan ms p95 | calls | without improvement calls: median / p95 "
+          "(calls) | first plan ms median | fallbacks |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for (s, p), _ in sorted(groups.items()):
         m = summary[f"{s}/{p}"]
         print(f"| {s} | {p} | {m['runs']} | {100 * m['success']:.1f} % | {100 * m['collision']:.1f} % "
               f"| {m['robot_caused']} | {_fmt(m['ratio_med'], 3)} | {_fmt(m['len'])} "
               f"| {_fmt(m['pt_med'], 1)} | {_fmt(m['pt_p95'], 1)} | {m['calls']} "
+              f"| {_fmt(m['pt_own_med'], 1)} / {_fmt(m['pt_own_p95'], 1)} ({m['calls_own']}) "
               f"| {_fmt(m['pt_first_med'], 1)} | {m['fallbacks']} |")
     for s in suites:  # ratios against seq-bitstar in this same run
         a, b = summary.get(f"{s}/st-bitstar"), summary.get(f"{s}/seq-bitstar")

@@ -134,7 +134,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
                  guard: str = "growth", manoeuvre_accel: float = 0.0,
                  passive_safety: bool = False, reach_extra_mps: float = 0.3,
                  reach_min_speed_mps: float = 0.0, search_budget_s: float | None = 0.02,
-                 improve_calls: int = 5, improve_budget_s: float | None = 0.01,
+                 improve_calls: int = 25, improve_budget_s: float | None = 0.01,
                  **kwargs: Any) -> None:
         loop = {k: kwargs.pop(k) for k in list(kwargs) if k in _LOOP_FIELDS}  # e.g. from --set
         if config is None:
