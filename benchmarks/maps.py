@@ -257,8 +257,8 @@ def _drive(sc: Scenario, planners: list[str], runs: int, label: str,
                   "no replanning")
         if len(own) != len(times):
             om = row["replan_own_ms_median"]
-            replan += (f" (without improvement calls: median "
-                       f"{om if om is not None else math.nan:.1f} ms over {len(own)} calls)")
+            replan += (f" (without improvement calls: median {om:.1f} ms over {len(own)} calls)"
+                       if om is not None else " (all of them improvement calls)")
         fp = row["first_plan_ms_median"]
         print(f"  {label:26s} {planner:12s} reached {reached}/{runs}, collisions {coll} "
               f"(robot-caused {caused}), first plan {fp if fp is not None else math.nan:.1f} ms, "
