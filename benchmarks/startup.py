@@ -75,12 +75,16 @@ def phased(name, f):
 cr.load_scenario = phased("load scenario", cr.load_scenario)
 for part, f in list(wu._RUN.items()):
     wu._RUN[part] = phased("warm-up " + part, f)
-first = sa.SequentialBITStarAgent._replan
+import anyplan.agents.spacetime as sta
+firsts = {cls: cls.__dict__["_replan"] for cls in (sa.SequentialBITStarAgent,
+                                                    sta.SpaceTimeBITStarAgent)}
 def replan(self, *a, **k):
-    sa.SequentialBITStarAgent._replan = first
+    for cls, f in firsts.items():
+        cls._replan = f
     mark("first planning call")
-    return first(self, *a, **k)
-sa.SequentialBITStarAgent._replan = replan
+    return type(self)._replan(self, *a, **k)
+for cls in firsts:  # st-bitstar (the default) has its own _replan
+    cls._replan = replan
 code = cm.main(["run", "paper-3", "--out", OUT, "--no-plot"])
 mark("end")
 json.dump(dict(code=code, marks=marks, compiles=rows), open(OUT + "/startup.json", "w"))
