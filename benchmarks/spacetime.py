@@ -14,7 +14,9 @@ lower bound (the result's ``time_lower_bound_s`` when present, otherwise the sam
 here: from rest under v_max and a_max along the visibility-graph shortest path to the edge of the
 goal tolerance), path length, and planning time per call (median and p95 over all calls; the
 number of calls, the same without st-bitstar's improvement calls (each on its own budget, made
-while the robot already drives a safe motion), and the median of the first plans from rest).
+while the robot already drives a safe motion), and the median of the first plans from rest),
+and the least distance between the robot's disc and a moving obstacle's disc over each run
+(median and minimum over the runs).
 
 st-bitstar and seq-bitstar run with a **fixed planning delay** of ``--delay`` seconds (0.1 by
 default): the new motion starts that long after the replanning decision whatever the computation
@@ -142,6 +144,7 @@ def run_one(job: tuple[str, int, str, int, dict[str, Any]]) -> dict[str, Any]:
             "status": res.status, "collision": res.collision, "robot_caused": robot_caused(res, sc),
             "time_to_goal": res.time_to_goal_s, "lower_bound": lb, "length": res.path_length_m,
             "plan_times": list(res.planning_times_s), "improving": improving,
+            "min_dist": d.get("min_distance_to_moving_m"),
             "fallbacks": len(res.extra.get("fallbacks", [])), "wall": time.perf_counter() - t0}
 
 
@@ -170,14 +173,19 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
                 "len": float(np.mean([r["path_length_m"] for r in ok])) if ok else math.nan,
                 "pt_med": float(np.median([r["solve_time_s"] for r in rows])) * 1e3,
                 "pt_p95": math.nan, "pt_first_med": math.nan, "calls": 0, "fallbacks": 0,
-                "pt_own_med": math.nan, "pt_own_p95": math.nan, "calls_own": 0}
+                "pt_own_med": math.nan, "pt_own_p95": math.nan, "calls_own": 0,
+                "dist_med": math.nan, "dist_min": math.nan}
     pt = np.array([t for r in rows for t in r["plan_times"]]) * 1e3
     # without st-bitstar's improvement calls (made while the robot has a safe motion already)
     pt_own = np.array([t for r in rows for t, imp in zip(r["plan_times"], r["improving"],
                                                          strict=True) if not imp]) * 1e3
     ok = [r for r in rows if r["status"] == "reached"]
     ratio = [r["time_to_goal"] / r["lower_bound"] for r in ok]
+    # robot's disc to the nearest moving obstacle's disc [m] (negative: overlap), per run
+    dist = [r["min_dist"] for r in rows if r.get("min_dist") is not None]
     return {"runs": len(rows), "success": len(ok) / len(rows),
+            "dist_med": float(np.median(dist)) if dist else math.nan,
+            "dist_min": float(np.min(dist)) if dist else math.nan,
             "collision": sum(r["collision"] for r in rows) / len(rows),
             "robot_caused": int(sum(r["robot_caused"] for r in rows)),
             "ratio_med": float(np.median(ratio)) if ratio else math.nan,
@@ -257,15 +265,16 @@ def main(argv: list[str] | None = None) -> int:
     summary = {f"{s}/{p}": summarise(g) for (s, p), g in groups.items()}
     print("\n| suite | planner | runs | success | collisions | robot-caused | time / bound (median) "
           "| path m | plan ms median | plan ms p95 | calls | without improvement calls: median / p95 "
-          "(calls) | first plan ms median | fallbacks |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "(calls) | first plan ms median | fallbacks | distance to moving m, median / min |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for (s, p), _ in sorted(groups.items()):
         m = summary[f"{s}/{p}"]
         print(f"| {s} | {p} | {m['runs']} | {100 * m['success']:.1f} % | {100 * m['collision']:.1f} % "
               f"| {m['robot_caused']} | {_fmt(m['ratio_med'], 3)} | {_fmt(m['len'])} "
               f"| {_fmt(m['pt_med'], 1)} | {_fmt(m['pt_p95'], 1)} | {m['calls']} "
               f"| {_fmt(m['pt_own_med'], 1)} / {_fmt(m['pt_own_p95'], 1)} ({m['calls_own']}) "
-              f"| {_fmt(m['pt_first_med'], 1)} | {m['fallbacks']} |")
+              f"| {_fmt(m['pt_first_med'], 1)} | {m['fallbacks']} "
+              f"| {_fmt(m['dist_med'], 3)} / {_fmt(m['dist_min'], 3)} |")
     for s in suites:  # ratios against seq-bitstar in this same run
         a, b = summary.get(f"{s}/st-bitstar"), summary.get(f"{s}/seq-bitstar")
         if a and b and b["pt_med"] > 0:
