@@ -30,7 +30,7 @@ from anyplan.agents.evasion import FallbackRanker, best_fallback, escape_time_s,
 from anyplan.agents.safety import finite_or_none, reachable_discs
 from anyplan.agents.sequential import SequentialBITStarAgent
 from anyplan.agents.st_predictions import PlanningPredictions
-from anyplan.agents.stats import SpaceTimeStats
+from anyplan.agents.stats import IMPROVE, SpaceTimeStats
 from anyplan.geometry.shapes import Shape
 from anyplan.planning.sequential import MotionModel, SequentialConfig, SequentialResult
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
@@ -48,9 +48,6 @@ _DEFAULT_LOOP = SequentialConfig(max_iterations=8, wait_delays_s=(), max_time_s=
 _LOOP_FIELDS = frozenset(f.name for f in dataclasses.fields(SequentialConfig))
 #: How far ahead [s] a motion in use is checked (a hold lasts "for ever").
 _CHECK_HORIZON_S = 60.0
-#: The reason of a replanning that looks for a motion earlier than the one in use
-#: (``improve_calls``).
-IMPROVE = "improve"
 #: Row duration [s] of the s-t maps.
 _ROW_H = 0.05
 

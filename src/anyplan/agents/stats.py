@@ -16,8 +16,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
-__all__ = ["StatsRecord", "SequentialStats", "SpaceTimeStats", "BITStarStats", "DOVSStats",
-           "TrackerCounts"]
+__all__ = ["IMPROVE", "StatsRecord", "SequentialStats", "SpaceTimeStats", "BITStarStats",
+           "DOVSStats", "TrackerCounts"]
+
+#: The ``extra.reasons`` entry of an ``st-bitstar`` replanning that looks for a motion earlier
+#: than the one in use (an improvement call: the robot already drives a safe motion).
+IMPROVE = "improve"
 
 
 @dataclass

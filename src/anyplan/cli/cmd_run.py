@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from anyplan.agents.base import AGENTS, make_agent
+from anyplan.agents.stats import IMPROVE
 from anyplan.cli import checks
 from anyplan.cli.agent_options import add_agent_options, run_config
 from anyplan.cli.perception_opts import add_perception_options, apply_perception
@@ -160,6 +161,8 @@ def _count(n: int, noun: str) -> str:
 def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
     """A few human-readable lines about a run."""
     pt = result.planning_times_s
+    # st-bitstar's improvement calls: made while the robot drives a safe motion already
+    n_imp = list(result.extra.get("reasons") or []).count(IMPROVE)
     lines = [
         f"{result.scenario} / {result.planner} / seed {result.seed}: {result.status}"
         + (f" (hit {result.collision_with} at t = {result.collision_time_s:.2f} s, "
@@ -172,7 +175,8 @@ def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
         f"  path length    {result.path_length_m:.3f} m",
         f"  min clearance  {result.min_clearance_m:.3f} m",
         f"  planning       {_count(len(pt), 'call')}, {sum(pt):.3f} s total, "
-        f"{_count(result.replans, 'replan')}",
+        f"{_count(result.replans, 'replan')}"
+        + (f" ({n_imp} of them improving the motion in use)" if n_imp else ""),
         *([f"  fallbacks      {len(result.extra['fallbacks'])}"]
           if result.extra.get("fallbacks") else []),
         f"  wrote          {out / 'result.json'}",
