@@ -61,6 +61,7 @@ from typing import Any
 import numpy as np
 
 from anyplan.agents import AGENTS, make_agent
+from anyplan.agents.stats import improvement_calls
 from anyplan.geometry import ObstacleSet
 from anyplan.planning import BITStar, Problem
 from anyplan.planning.visgraph import shortest_path
@@ -229,12 +230,9 @@ def _drive(sc: Scenario, planners: list[str], runs: int, label: str,
             wall += time.perf_counter() - w0
             first += res.planning_times_s[:1]
             times += res.planning_times_s[1:]
-            reasons = list(res.extra.get("reasons", []))
-            if len(reasons) == len(res.planning_times_s):  # st-bitstar's improvement calls apart
-                own += [t for t, r in zip(res.planning_times_s[1:], reasons[1:], strict=True)
-                        if r != "improve"]
-            else:
-                own += res.planning_times_s[1:]
+            improving = improvement_calls(res.extra, len(res.planning_times_s))
+            own += [t for t, imp in zip(res.planning_times_s[1:], improving[1:], strict=True)
+                    if not imp]  # st-bitstar's improvement calls apart
             reached += bool(res.reached_goal)
             coll += bool(res.collision)
             caused += bool(_robot_caused(sc, res))

@@ -127,6 +127,7 @@ def robot_caused(res: Any, sc: Any) -> bool:
 def run_one(job: tuple[str, int, str, int, dict[str, Any]]) -> dict[str, Any]:
     """One simulated run (top level so that worker processes can call it)."""
     from anyplan.agents import make_agent
+    from anyplan.agents.stats import improvement_calls
     from anyplan.simulation import simulate
 
     suite, index, planner, seed, opts = job
@@ -137,9 +138,7 @@ def run_one(job: tuple[str, int, str, int, dict[str, Any]]) -> dict[str, Any]:
     res = simulate(sc, make_agent(planner, **kw), seed=seed)
     d = res.to_dict()
     lb = d.get("time_lower_bound_s") or lower_bound(sc)
-    reasons = list(res.extra.get("reasons", []))
-    improving = ([r == "improve" for r in reasons] if len(reasons) == len(res.planning_times_s)
-                 else [False] * len(res.planning_times_s))
+    improving = improvement_calls(res.extra, len(res.planning_times_s))
     return {"suite": suite, "scenario": sc.name, "planner": planner, "seed": seed,
             "status": res.status, "collision": res.collision, "robot_caused": robot_caused(res, sc),
             "time_to_goal": res.time_to_goal_s, "lower_bound": lb, "length": res.path_length_m,

@@ -16,12 +16,29 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
-__all__ = ["IMPROVE", "StatsRecord", "SequentialStats", "SpaceTimeStats", "BITStarStats",
+__all__ = ["IMPROVE", "improvement_calls", "StatsRecord", "SequentialStats", "SpaceTimeStats", "BITStarStats",
            "DOVSStats", "TrackerCounts"]
 
 #: The ``extra.reasons`` entry of an ``st-bitstar`` replanning that looks for a motion earlier
 #: than the one in use (an improvement call: the robot already drives a safe motion).
 IMPROVE = "improve"
+
+
+def improvement_calls(extra: dict[str, Any], n_calls: int) -> list[bool]:
+    """Which of a run's ``n_calls`` planning calls (``planning_times_s``) were improvement
+    calls, from its ``extra.reasons`` (one reason a call); all False when the run has no
+    reason for every call (an agent that makes none).
+
+    Examples:
+        >>> improvement_calls({"reasons": ["initial", IMPROVE, "holding"]}, 3)
+        [False, True, False]
+        >>> improvement_calls({}, 2)
+        [False, False]
+    """
+    reasons = list(extra.get("reasons") or [])
+    if len(reasons) != n_calls:
+        return [False] * n_calls
+    return [r == IMPROVE for r in reasons]
 
 
 @dataclass

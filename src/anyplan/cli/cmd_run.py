@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from anyplan.agents.base import AGENTS, make_agent
-from anyplan.agents.stats import IMPROVE
+from anyplan.agents.stats import improvement_calls
 from anyplan.cli import checks
 from anyplan.cli.agent_options import add_agent_options, run_config
 from anyplan.cli.perception_opts import add_perception_options, apply_perception
@@ -162,7 +162,7 @@ def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
     """A few human-readable lines about a run."""
     pt = result.planning_times_s
     # st-bitstar's improvement calls: made while the robot drives a safe motion already
-    n_imp = list(result.extra.get("reasons") or []).count(IMPROVE)
+    n_imp = sum(improvement_calls(result.extra, len(pt)))
     lines = [
         f"{result.scenario} / {result.planner} / seed {result.seed}: {result.status}"
         + (f" (hit {result.collision_with} at t = {result.collision_time_s:.2f} s, "
