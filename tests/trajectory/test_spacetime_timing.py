@@ -207,3 +207,24 @@ def test_retime_rejects_polyline_motions():
 
     two = Trajectory(tr.segments + tr.segments, kind="polyline")
     assert retime(two, [_crossing()], SPEC).trajectory is None
+
+
+@pytest.mark.parametrize("cached", [False, True])
+def test_a_prediction_that_ends_marks_nothing_after_its_end(cached):
+    # A receding-horizon prediction (``until``) has no disc after its end: its map is the map of
+    # the unending prediction before the end, and free after it. Before, a row after the end
+    # (radius -inf) passed the exact test with an infinite squared reach and marked every cell
+    # of the path's chunks near the obstacle. With a cache kept across replannings, a prediction
+    # of the same motion that ends elsewhere gets rows of its own.
+    motion = UnicycleMotion(4.0, 2.2, 0.0, 0.0)  # standing on the route
+    rows = RowCache(0.0, 0.05) if cached else None
+    endless = build_stmap(_pts, 8.0, [PredictedObstacle("S", 0.3, motion)], SPEC.radius, 0.0,
+                          20.0, margin=0.05, rows=rows)
+    for until in (5.0, 12.5):
+        ends = build_stmap(_pts, 8.0, [PredictedObstacle("S", 0.3, motion, until=until)],
+                           SPEC.radius, 0.0, 20.0, margin=0.05, rows=rows)
+        j_end = int(until / ends.h)  # the row that contains the end still has the disc
+        assert np.array_equal(ends.forbidden[:j_end + 1], endless.forbidden[:j_end + 1])
+        assert endless.forbidden[:j_end + 1].any(axis=1).all()
+        assert not ends.forbidden[j_end + 1:].any()
+        assert endless.forbidden[j_end + 1:].any(axis=1).all()

@@ -76,6 +76,8 @@ def _fill(out: np.ndarray, px: np.ndarray, py: np.ndarray, cx: np.ndarray, cy: n
                     c1 = min((g + 1) * chunk, ncell)
                     for j in range(j0, j1):
                         r = reach[o, j]
+                        if r < 0.0:
+                            continue  # no disc in this row (after the prediction's end)
                         x, y = qx[o, j], qy[o, j]
                         dx, dy = x - cx[g], y - cy[g]
                         lim = r + crad[g] + 1e-9
@@ -104,14 +106,15 @@ def _bounding_circles(px: np.ndarray, py: np.ndarray, size: int
     return cx, cy, np.nanmax(np.hypot(xs - cx[:, None], ys - cy[:, None]), axis=1)
 
 
-def _row_key(o: Any) -> tuple[int, Any, float]:
+def _row_key(o: Any) -> tuple[int, Any, tuple[float, float] | None]:
     """What an obstacle's rows depend on: a prediction of fixed size (``growth`` None) by its
-    motion and radius (a new prediction of the same announced motion shares its rows), any
-    other by itself. Returns (key, the object the entry holds, radius or nan)."""
+    motion, radius and end (``until``: a new prediction of the same announced motion shares
+    its rows, one that ends at another time does not), any other by itself. Returns (key, the
+    object the entry holds, (radius [m], until [s]) or None)."""
     m = getattr(o, "motion", None)
     if m is not None and getattr(o, "growth", 0) is None:
-        return id(m), m, float(o.radius)
-    return id(o), o, math.nan
+        return id(m), m, (float(o.radius), float(getattr(o, "until", math.inf)))
+    return id(o), o, None
 
 
 class RowCache:
@@ -128,7 +131,8 @@ class RowCache:
 
     def __init__(self, t_origin: float, h: float) -> None:
         self.t_origin, self.h = float(t_origin), float(h)
-        self._rows: dict[int, tuple[Any, int, int, np.ndarray, np.ndarray, float]] = {}
+        self._rows: dict[int, tuple[Any, int, int, np.ndarray, np.ndarray,
+                                   tuple[float, float] | None]] = {}
         self._stack: tuple[list[Any], int, int, np.ndarray, np.ndarray, np.ndarray] | None = None
         self._j_begin = 0
         self._used: set[int] = set()
@@ -153,11 +157,11 @@ class RowCache:
     def rows(self, o: Any, j0: int, j1: int) -> tuple[np.ndarray, np.ndarray]:
         """Centres (j1 - j0, 2) [m] at the rows' middles and largest radii (j1 - j0,) [m] at
         their ends and middles, rows j0 .. j1 - 1."""
-        key, holder, radius = _row_key(o)
+        key, holder, size = _row_key(o)
         self._used.add(key)
         e = self._rows.get(key)
-        if e is not None and (e[0] is not holder or not (e[5] == radius or math.isnan(radius))):
-            e = None  # not the same motion, or another radius
+        if e is not None and (e[0] is not holder or e[5] != size):
+            e = None  # not the same motion, or another radius or end
         if e is None or not (e[1] <= j0 and j1 <= e[2]):
             # Rows to spare: the next map (a longer path, a longer wait) needs a few more.
             if e is None:
@@ -171,7 +175,7 @@ class RowCache:
             q = np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2)
             r_edge = radii_at(o, t_edges)
             r_max = np.maximum(radii_at(o, t_mid), np.maximum(r_edge[:-1], r_edge[1:]))
-            e = (holder, a, b, q, r_max, radius)
+            e = (holder, a, b, q, r_max, size)
             self._rows[key] = e
         return e[3][j0 - e[1]:j1 - e[1]], e[4][j0 - e[1]:j1 - e[1]]
 
