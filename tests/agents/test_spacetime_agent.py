@@ -610,3 +610,43 @@ def test_search_budget_takes_the_best_candidate_once_one_is_timed():
     assert full.record.st_candidates[0] > quick.record.st_candidates[0]
     assert full.stats.plans[0]["arrival_s"] <= quick.stats.plans[0]["arrival_s"] + 1e-9
     assert quick.stats.plans[0]["kind"] != "fallback-hold"
+
+
+def test_announced_motions_are_planned_on_a_receding_horizon():
+    # Announced motions end at announced_horizon_s after the call (planned, timed and checked
+    # that far ahead, no guard: they are certain); None keeps them whole. Predictions that end
+    # as observed (twist, tracked) keep their own horizon.
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.world import UnicycleMotion
+
+    motion = UnicycleMotion(6.0, 0.5, math.pi / 2, 0.3)
+    announced = [PredictedObstacle("X", 0.3, motion)]
+    p = np.array([1.0, 3.0])
+    for horizon in (30.0, 5.0, None):
+        agent = make_agent("st-bitstar", announced_horizon_s=horizon)
+        agent.reset(_crossing_scenario(), np.random.default_rng(0))
+        planned, guarded = agent._split(announced, p, 2.0)
+        assert guarded is None
+        assert [o.until for o in planned] == [math.inf if horizon is None else 2.0 + horizon]
+        assert planned[0].motion is motion and planned[0].radius == 0.3
+    twist = [PredictedObstacle("X", 0.3, motion, until=10.0)]
+    assert agent._split(twist, p, 2.0)[0][0].until == math.inf  # guard "growth": in full
+    agent = make_agent("st-bitstar", announced_horizon_s=5.0, guard="horizon")
+    agent.reset(_crossing_scenario(), np.random.default_rng(0))
+    assert [o.until for o in agent._split(twist, np.array([5.0, 2.5]), 2.0)[0]] == [10.0]
+    for bad in (0.0, -1.0, "far"):
+        with pytest.raises(ValueError, match="announced_horizon_s"):
+            make_agent("st-bitstar", announced_horizon_s=bad)
+
+
+def test_a_crossing_beyond_the_announced_horizon_is_replanned_and_avoided():
+    # The crossing (at about 13 s) is beyond a 5 s horizon at the start: the first motion
+    # drives into it as far as it knows; as the crossing comes within the horizon, a check
+    # predicts it and the robot replans, and passes without collision.
+    r = simulate(_crossing_scenario(), make_agent("st-bitstar", announced_horizon_s=5.0,
+                                                  **_fixed()), seed=0)
+    assert r.status == "reached" and not r.collision
+    assert any(x.startswith("collision with X predicted") for x in r.extra["reasons"])
+    whole = simulate(_crossing_scenario(), make_agent("st-bitstar", announced_horizon_s=None,
+                                                      **_fixed()), seed=0)
+    assert not any(x.startswith("collision") for x in whole.extra["reasons"])

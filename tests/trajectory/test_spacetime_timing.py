@@ -130,12 +130,10 @@ def test_stacked_rows_are_each_obstacles_rows_and_name_the_blockers():
         assert m.blockers == ["G", "X"]
 
 
-def test_rows_are_shared_by_later_replannings_of_the_same_motions_only():
-    # A RowCache kept across replannings (begin() at each): a new prediction of the same motion
-    # and radius reuses its rows without sampling the motion again, and the rows are the same;
-    # another radius, or a growing disc made anew, gets rows of its own; entries the last
-    # replanning did not use are dropped (predictions made anew each time never come back).
-    calls = []
+def _cached_crossing():
+    """A crossing motion that logs the length of every sampling, and a RowCache that has
+    sampled it once (rows 20-399 of its first replanning, at 1 s): (log, motion, cache, rows)."""
+    calls: list[int] = []
 
     class Counted(UnicycleMotion):
         def positions(self, t):
@@ -145,7 +143,15 @@ def test_rows_are_shared_by_later_replannings_of_the_same_motions_only():
     motion = Counted(5.0, -1.3, np.pi / 2, 0.3)
     rows = RowCache(0.0, 0.05)
     rows.begin(1.0)
-    first = rows.rows_all([PredictedObstacle("X", 0.3, motion)], 20, 400)
+    return calls, motion, rows, rows.rows_all([PredictedObstacle("X", 0.3, motion)], 20, 400)
+
+
+def test_rows_are_shared_by_later_replannings_of_the_same_motions_only():
+    # A RowCache kept across replannings (begin() at each): a new prediction of the same motion
+    # and radius reuses its rows without sampling the motion again, and the rows are the same;
+    # another radius, or a growing disc made anew, gets rows of its own; entries the last
+    # replanning did not use are dropped (predictions made anew each time never come back).
+    calls, motion, rows, first = _cached_crossing()
     n = len(calls)
     rows.begin(1.2)
     again = rows.rows_all([PredictedObstacle("X", 0.3, motion)], 24, 300)
@@ -228,3 +234,23 @@ def test_a_prediction_that_ends_marks_nothing_after_its_end(cached):
         assert endless.forbidden[:j_end + 1].any(axis=1).all()
         assert not ends.forbidden[j_end + 1:].any()
         assert endless.forbidden[j_end + 1:].any(axis=1).all()
+
+
+def test_rows_of_one_motion_are_shared_whatever_its_predictions_end():
+    # A receding horizon makes each replanning's predictions end at another time: the rows of
+    # the same motion and radius are still sampled once, and each end is applied on reading.
+    calls, motion, rows, full = _cached_crossing()
+    n = len(calls)
+    for until in (4.0, 9.97, 15.0):
+        rows.begin(1.0)
+        q_x, _, r = rows.rows_all([PredictedObstacle("X", 0.3, motion, until=until)], 20, 400)
+        one = rows.rows(PredictedObstacle("X", 0.3, motion, until=until), 20, 400)
+        assert len(calls) == n  # not sampled again
+        assert np.array_equal(q_x, full[0]) and np.array_equal(r[0], one[1])
+        starts = 0.05 * np.arange(20, 400)
+        assert np.array_equal(r[0], np.where(starts <= until, full[2][0], -np.inf))
+        # a row has the disc as radius_at says at its start, middle or end
+        ends = 0.05 * np.arange(20, 401)
+        at = PredictedObstacle("X", 0.3, motion, until=until).radius_at
+        r_ref = np.maximum(at(starts + 0.025), np.maximum(at(ends[:-1]), at(ends[1:])))
+        assert np.array_equal(r[0], r_ref)

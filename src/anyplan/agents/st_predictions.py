@@ -1,10 +1,11 @@
 """What ``st-bitstar`` plans against, and what its safety guard checks, from the predictions.
 
 Certain predictions (announced motions; exact twists with ``guard="growth"``) are planned
-against in full. Uncertain ones (tracked: discs that grow with the horizon) are planned and
-timed against discs whose extra radius is capped at ``plan_extra_m``, on a receding horizon,
-while the safety guard checks the full growth (``docs/perception.md``, "st-bitstar when the
-future is unknown"). :class:`PlanningPredictions` is the agent's part that makes these views.
+against in full, announced motions up to ``announced_horizon_s`` ahead. Uncertain ones
+(tracked: discs that grow with the horizon) are planned and timed against discs whose extra
+radius is capped at ``plan_extra_m``, on a receding horizon, while the safety guard checks the
+full growth (``docs/perception.md``, "st-bitstar when the future is unknown").
+:class:`PlanningPredictions` is the agent's part that makes these views.
 """
 
 from __future__ import annotations
@@ -25,13 +26,15 @@ _INSIDE_GAP_M = 0.02
 
 class PlanningPredictions:
     """The views of the predictions an ``st-bitstar`` agent plans with (a mixin: it reads the
-    agent's ``spec``, ``config.margin``, ``guard_mode``, ``plan_extra_m`` and ``record``)."""
+    agent's ``spec``, ``config.margin``, ``guard_mode``, ``plan_extra_m``,
+    ``announced_horizon_s`` and ``record``)."""
 
     spec: Any
     config: Any
     record: Any
     guard_mode: str
     plan_extra_m: float | None
+    announced_horizon_s: float | None
 
     def _planning_preds(self, preds: list[PredictedObstacle], p: np.ndarray,
                         t: float) -> list[PredictedObstacle]:
@@ -71,11 +74,24 @@ class PlanningPredictions:
                ) -> tuple[list[PredictedObstacle], list[PredictedObstacle] | None]:
         """The predictions planned and timed against from ``p`` at ``t`` [s], and the full
         ones the safety guard checks (None when every prediction is certain: no guard)."""
+        announced = bool(preds) and all(o.until == math.inf for o in preds)
         preds = self._certain(preds)
+        if announced:
+            return self._announced(preds, t), None
         safe = self._planning_preds(preds, p, t)
         if safe is preds:
             return preds, None
         return self._capped(safe), safe
+
+    def _announced(self, preds: list[PredictedObstacle], t: float) -> list[PredictedObstacle]:
+        """Announced motions on the receding horizon ``announced_horizon_s`` from ``t`` [s]:
+        each prediction ends there (``until``), so that a timing no longer has to thread a
+        long path through every obstacle's whole future (the motion in use is checked again
+        at every check, each time up to the horizon from then). None: in full."""
+        h = self.announced_horizon_s
+        if h is None:
+            return preds
+        return [dataclasses.replace(o, until=t + h) for o in preds]
 
     def _certain(self, preds: list[PredictedObstacle]) -> list[PredictedObstacle]:
         """With ``guard="growth"``, exact-twist predictions (no uncertain disc: ``twist``

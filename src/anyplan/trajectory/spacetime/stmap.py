@@ -106,15 +106,15 @@ def _bounding_circles(px: np.ndarray, py: np.ndarray, size: int
     return cx, cy, np.nanmax(np.hypot(xs - cx[:, None], ys - cy[:, None]), axis=1)
 
 
-def _row_key(o: Any) -> tuple[int, Any, tuple[float, float] | None]:
+def _row_key(o: Any) -> tuple[int, Any, float | None, float]:
     """What an obstacle's rows depend on: a prediction of fixed size (``growth`` None) by its
-    motion, radius and end (``until``: a new prediction of the same announced motion shares
-    its rows, one that ends at another time does not), any other by itself. Returns (key, the
-    object the entry holds, (radius [m], until [s]) or None)."""
+    motion and radius (a new prediction of the same announced motion shares its rows, whatever
+    its end), any other by itself. Returns (key, the object the entry holds, radius [m] or
+    None, the end [s] applied to the fixed-size rows when they are read: ``until``, or inf)."""
     m = getattr(o, "motion", None)
     if m is not None and getattr(o, "growth", 0) is None:
-        return id(m), m, (float(o.radius), float(getattr(o, "until", math.inf)))
-    return id(o), o, None
+        return id(m), m, float(o.radius), float(getattr(o, "until", math.inf))
+    return id(o), o, None, math.inf
 
 
 class RowCache:
@@ -131,8 +131,7 @@ class RowCache:
 
     def __init__(self, t_origin: float, h: float) -> None:
         self.t_origin, self.h = float(t_origin), float(h)
-        self._rows: dict[int, tuple[Any, int, int, np.ndarray, np.ndarray,
-                                   tuple[float, float] | None]] = {}
+        self._rows: dict[int, tuple[Any, int, int, np.ndarray, np.ndarray, float | None]] = {}
         self._stack: tuple[list[Any], int, int, np.ndarray, np.ndarray, np.ndarray] | None = None
         self._j_begin = 0
         self._used: set[int] = set()
@@ -157,11 +156,25 @@ class RowCache:
     def rows(self, o: Any, j0: int, j1: int) -> tuple[np.ndarray, np.ndarray]:
         """Centres (j1 - j0, 2) [m] at the rows' middles and largest radii (j1 - j0,) [m] at
         their ends and middles, rows j0 .. j1 - 1."""
-        key, holder, size = _row_key(o)
+        q, r, until = self._entry(o, j0, j1)
+        if until < math.inf:
+            r = np.where(self._row_starts(j0, j1) <= until, r, -math.inf)
+        return q, r
+
+    def _row_starts(self, j0: int, j1: int) -> np.ndarray:
+        """Start times [s] of rows j0 .. j1 - 1."""
+        return self.t_origin + self.h * np.arange(j0, j1)
+
+    def _entry(self, o: Any, j0: int, j1: int) -> tuple[np.ndarray, np.ndarray, float]:
+        """:meth:`rows` before a fixed-size prediction's end is applied, and that end [s]
+        (inf for the others, whose radii already say it): a row whose start is after the end
+        has no disc (radius -inf, as ``radius_at`` says); one that starts at or before it has
+        the disc at its start."""
+        key, holder, size, until = _row_key(o)
         self._used.add(key)
         e = self._rows.get(key)
         if e is not None and (e[0] is not holder or e[5] != size):
-            e = None  # not the same motion, or another radius or end
+            e = None  # not the same motion, or another radius
         if e is None or not (e[1] <= j0 and j1 <= e[2]):
             # Rows to spare: the next map (a longer path, a longer wait) needs a few more.
             if e is None:
@@ -171,13 +184,16 @@ class RowCache:
                 b = max(e[2] + (e[2] - a), j1)
             j = np.arange(a, b)
             t_mid = self.t_origin + self.h * (j + 0.5)
-            t_edges = self.t_origin + self.h * np.arange(a, b + 1)
             q = np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2)
-            r_edge = radii_at(o, t_edges)
-            r_max = np.maximum(radii_at(o, t_mid), np.maximum(r_edge[:-1], r_edge[1:]))
+            if size is not None:  # fixed size: the end is applied below
+                r_max = np.full(len(j), size)
+            else:
+                t_edges = self.t_origin + self.h * np.arange(a, b + 1)
+                r_edge = radii_at(o, t_edges)
+                r_max = np.maximum(radii_at(o, t_mid), np.maximum(r_edge[:-1], r_edge[1:]))
             e = (holder, a, b, q, r_max, size)
             self._rows[key] = e
-        return e[3][j0 - e[1]:j1 - e[1]], e[4][j0 - e[1]:j1 - e[1]]
+        return e[3][j0 - e[1]:j1 - e[1]], e[4][j0 - e[1]:j1 - e[1]], until
 
     def rows_all(self, obstacles: Sequence[Any], j0: int, j1: int
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -194,16 +210,20 @@ class RowCache:
             a, b = min(j0, self._j_begin), j1 + _SPARE_ROWS
             if st is not None and same:
                 a, b = min(st[1], a), max(st[2], b)
-            parts = [self.rows(o, a, b) for o in obstacles]
+            parts = [self._entry(o, a, b) for o in obstacles]
             # the rows each obstacle's entry holds (rows to spare included) bound the stack
             held = [self._rows[_row_key(o)[0]] for o in obstacles]
             hi = min(e[2] for e in held)
             if all(e[1] <= a for e in held) and b <= hi:
-                parts = [self.rows(o, a, hi) for o in obstacles]
+                parts = [self._entry(o, a, hi) for o in obstacles]
                 b = hi
             q = np.stack([p[0] for p in parts])
+            r = np.stack([p[1] for p in parts])
+            until = np.array([p[2] for p in parts])
+            if np.any(until < math.inf):  # the ends, all at once
+                r = np.where(self._row_starts(a, b)[None, :] <= until[:, None], r, -math.inf)
             st = (list(obstacles), a, b, np.ascontiguousarray(q[:, :, 0]),
-                  np.ascontiguousarray(q[:, :, 1]), np.stack([p[1] for p in parts]))
+                  np.ascontiguousarray(q[:, :, 1]), r)
             self._stack = st
         i0, i1 = j0 - st[1], j1 - st[1]
         return st[3][:, i0:i1], st[4][:, i0:i1], st[5][:, i0:i1]
