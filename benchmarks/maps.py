@@ -41,6 +41,7 @@ Usage::
     python benchmarks/maps.py --json out.json --out maps/   # keep the results and the maps
     python benchmarks/maps.py --quick --no-static --deterministic   # A/B two commits
     python benchmarks/maps.py --quick --no-static --perception tracked   # walkers detected, not known
+    python benchmarks/maps.py --quick --no-static --set st-bitstar:announced_horizon_s=null
 """
 
 from __future__ import annotations
@@ -61,7 +62,9 @@ from typing import Any
 import numpy as np
 
 from anyplan.agents import AGENTS, make_agent
+from anyplan.agents.settings import SettingsError
 from anyplan.agents.stats import improvement_calls
+from anyplan.cli.agent_options import add_agent_options, bench_configs
 from anyplan.geometry import ObstacleSet
 from anyplan.planning import BITStar, Problem
 from anyplan.planning.visgraph import shortest_path
@@ -70,6 +73,8 @@ from anyplan.world import load_scenario
 from anyplan.world.scenario import Scenario
 
 BUDGETS_S = (0.05, 0.2, 1.0)
+#: The planners of sections 2-3.
+PLANNERS = ["seq-bitstar"] + (["st-bitstar"] if "st-bitstar" in AGENTS else [])
 ARC_STEP = math.pi / 8
 
 
@@ -210,7 +215,7 @@ def _robot_caused(sc: Scenario, res: Any) -> bool | None:
 
 
 def _drive(sc: Scenario, planners: list[str], runs: int, label: str,
-           deterministic: bool = False, perception: str | None = None) -> list[dict[str, Any]]:
+           configs: dict[str, dict[str, Any]], perception: str | None = None) -> list[dict[str, Any]]:
     if perception is not None:
         from anyplan.simulation.perception import override_sensing
 
@@ -220,7 +225,7 @@ def _drive(sc: Scenario, planners: list[str], runs: int, label: str,
         times, first, reached, coll, caused, ttg, cpu, wall = [], [], 0, 0, 0, [], 0.0, 0.0
         own: list[float] = []  # replanning calls other than improvement calls
         digest = hashlib.sha1()
-        kw = (AGENTS.get(planner).deterministic_settings or {}) if deterministic else {}
+        kw = configs.get(planner, {})
         for s in range(runs):
             gc.collect()
             c0, w0 = time.process_time(), time.perf_counter()
@@ -266,19 +271,20 @@ def _drive(sc: Scenario, planners: list[str], runs: int, label: str,
     return rows
 
 
-def dynamic_section(maps_dir: Path, quick: bool, deterministic: bool = False,
+def dynamic_section(maps_dir: Path, quick: bool, configs: dict[str, dict[str, Any]],
                     perception: str | None = None) -> list[dict[str, Any]]:
+    """Sections 2-3; ``configs``: each planner's settings (``--set``, ``--deterministic``)."""
     from anyplan.experiments.floorplans import map_scenario, office, roughen
     from anyplan.experiments.many import many_obstacles
 
-    planners = ["seq-bitstar"] + (["st-bitstar"] if "st-bitstar" in AGENTS else [])
+    planners = PLANNERS
     runs = 1 if quick else 3
     print("\nwalkers in the office corridor, and many moving obstacles (the first plan, from rest "
           "at the start, apart from the replanning calls while driving; walkers perceived "
           f"{perception or 'as each scenario says (oracle)'})")
     plan = roughen(office(30, 20, rng=1), 0.3, 50, rng=1)
     # peer: the paper's scenario in the same run (README: 15.3 ms median on an unloaded machine)
-    det = deterministic
+    det = configs
     rows = _drive(load_scenario("paper-3"), planners, 1, "peer: paper-3", det)
     for n in (2, 4):
         path = map_scenario(plan, maps_dir, f"office-walkers-{n}", n_walkers=n, rng=n)
@@ -300,10 +306,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--perception", choices=("oracle", "twist", "tracked"), default=None,
                     help="how the robot perceives the office's walkers (default: the scenario's "
                          "oracle, their whole motion; with tracked the agents replan as they go)")
-    ap.add_argument("--deterministic", action="store_true",
-                    help="sections 2-3 with the agents' --deterministic settings (runs depend only on "
-                         "the code: compare two commits by the printed trajectory digests)")
+    # sections 2-3: --set [PLANNER:]KEY=VALUE and --deterministic, as anyplan bench's (with
+    # --deterministic runs depend only on the code: compare two commits by the printed digests)
+    add_agent_options(ap, bench=True)
     args = ap.parse_args(argv)
+    try:
+        configs = bench_configs(args, PLANNERS)
+    except SettingsError as exc:  # a bad --set: one line, exit 2
+        ap.error(str(exc))
     seeds = args.seeds or (5 if args.quick else 10)
     with tempfile.TemporaryDirectory() as tmp:
         maps_dir = Path(args.out or tmp)
@@ -315,8 +325,7 @@ def main(argv: list[str] | None = None) -> int:
         if not args.no_static:
             out["static"] = static_section(maps_dir, args.quick, seeds)
         if not args.no_dynamic:
-            out["dynamic"] = dynamic_section(maps_dir, args.quick, args.deterministic,
-                                             args.perception)
+            out["dynamic"] = dynamic_section(maps_dir, args.quick, configs, args.perception)
     if args.json:
         Path(args.json).write_text(json.dumps(out, indent=1, default=float))
     return 0

@@ -32,6 +32,7 @@ Usage::
 
     python benchmarks/spacetime.py --quick            # a few minutes
     python benchmarks/spacetime.py --jobs 2 --out benchmarks/results/spacetime.json
+    python benchmarks/spacetime.py --planners st-bitstar --strrt-budgets none --set announced_horizon_s=null
 """
 
 from __future__ import annotations
@@ -133,7 +134,7 @@ def run_one(job: tuple[str, int, str, int, dict[str, Any]]) -> dict[str, Any]:
     suite, index, planner, seed, opts = job
     args = argparse.Namespace(**opts)
     sc = _scenario(suite, index, args)
-    kw = {"planning_delay": args.delay} if planner != "dovs" else {}
+    kw = args.agent_configs.get(planner, {})  # --delay, then --set and --deterministic
     t0 = time.perf_counter()
     res = simulate(sc, make_agent(planner, **kw), seed=seed)
     d = res.to_dict()
@@ -201,6 +202,10 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from anyplan.agents import AGENTS
+    from anyplan.agents.settings import SettingsError
+    from anyplan.cli.agent_options import add_agent_options, bench_configs
+
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true",
                     help="paper x 2 seeds, 1 random per count, 6 gap worlds, 6 DynaBARN worlds, "
@@ -219,14 +224,22 @@ def main(argv: list[str] | None = None) -> int:
                     help="directory with the ompl 1.7 wheel (pip install --target), if not installed")
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--out", default=None, help="write every run and the summary as JSON")
+    add_agent_options(ap, bench=True)  # --set [PLANNER:]KEY=VALUE, --deterministic (anyplan bench's)
     args = ap.parse_args(argv)
     if args.quick:
         args.seeds, args.random, args.gaps, args.dynabarn = 2, 1, 6, "20,25,30,40,45,50"
         args.strrt_budgets, args.strrt_suites = "1", "paper"
     suites = [s.strip() for s in args.suites.split(",") if s.strip()]
     planners = [p.strip() for p in args.planners.split(",") if p.strip()]
+    try:
+        configs = bench_configs(args, [p for p in planners if p in AGENTS],
+                                base={p: {"planning_delay": args.delay} for p in planners
+                                      if p != "dovs"})
+    except SettingsError as exc:  # a bad --set: one line, exit 2
+        ap.error(str(exc))
     opts = {k: getattr(args, k) for k in ("random", "gaps", "dynabarn", "worlds_file", "delay",
                                           "strrt_site")}
+    opts["agent_configs"] = configs
     jobs = []
     sizes = {}
     for suite in suites:
