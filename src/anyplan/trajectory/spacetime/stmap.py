@@ -58,9 +58,11 @@ def _fill(out: np.ndarray, px: np.ndarray, py: np.ndarray, cx: np.ndarray, cy: n
             j0, j1 = b * _BLOCK, min((b + 1) * _BLOCK, nrow)
             jm = (j0 + j1) // 2
             # every row of the block is within spread[o] * (rows apart) of the middle row
-            rb = 0.0
+            rb = -np.inf
             for j in range(j0, j1):
                 rb = max(rb, reach[o, j])
+            if rb < 0.0:
+                continue  # no disc in any row of the block (after the prediction's end)
             rb += spread[o] * max(jm - j0, j1 - 1 - jm) + 1e-9
             xm, ym = qx[o, jm], qy[o, jm]
             for k in range(sx.shape[0]):
