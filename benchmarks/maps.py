@@ -284,14 +284,13 @@ def dynamic_section(maps_dir: Path, quick: bool, configs: dict[str, dict[str, An
           f"{perception or 'as each scenario says (oracle)'})")
     plan = roughen(office(30, 20, rng=1), 0.3, 50, rng=1)
     # peer: the paper's scenario in the same run (README: 15.3 ms median on an unloaded machine)
-    det = configs
-    rows = _drive(load_scenario("paper-3"), planners, 1, "peer: paper-3", det)
+    rows = _drive(load_scenario("paper-3"), planners, 1, "peer: paper-3", configs)
     for n in (2, 4):
         path = map_scenario(plan, maps_dir, f"office-walkers-{n}", n_walkers=n, rng=n)
-        rows += _drive(load_scenario(path), planners, runs, f"office-30x20 + {n} walkers", det,
+        rows += _drive(load_scenario(path), planners, runs, f"office-30x20 + {n} walkers", configs,
                        perception)
     for n in (25, 50, 100):
-        rows += _drive(many_obstacles(n, rng=n), planners, runs, f"hall 40x30 + {n} movers", det)
+        rows += _drive(many_obstacles(n, rng=n), planners, runs, f"hall 40x30 + {n} movers", configs)
     return rows
 
 

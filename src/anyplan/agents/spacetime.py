@@ -212,7 +212,6 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         self._path: np.ndarray | None = None
         self._shapes: list[Shape] = []
         self._preds: list[PredictedObstacle] = []
-        self._observed_horizon = False
         self._rows: RowCache | None = None
         #: Nominal motions of this replanning and whether each is free as timed (``_timed_fn``).
         self._nominals: dict[tuple[Any, ...], tuple[Trajectory, bool | None, list[Shape]]] = {}
@@ -418,8 +417,6 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         dt, d, t_ready, state = self._begin_replan(obs)
         t = obs.t
         observed = preds
-        # whether the predictions end as observed (twist, tracked), not on announced_horizon_s
-        self._observed_horizon = any(o.until < math.inf for o in observed)
         preds, safe = self._split(preds, np.array([state.x, state.y]), t_ready)
         uncertain = safe is not None
         # Improving: the motion in use (checked free just before) is the candidate to beat.
@@ -486,8 +483,12 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
             return  # kept (checked free before this call)
         # Late: the computed motion starts in the past. Re-time from the state the robot will
         # really have, on the same path (no new search).
-        t_switch, motion = self._take_up(obs, t_ready, wall, d, dt, motion,
-                                         lambda state, t_s: self._retime_path(state, t_s, path, shapes))
+        # the predictions end as observed (twist, tracked), or on announced_horizon_s
+        ends_s = (self.prediction_horizon_s if any(o.until < math.inf for o in observed)
+                  else self.announced_horizon_s)
+        t_switch, motion = self._take_up(
+            obs, t_ready, wall, d, dt, motion,
+            lambda state, t_s: self._retime_path(state, t_s, path, shapes, ends_s))
         if (safe is not None and self._guarded_by(safe)) or (
                 self.passive_safety and any(o.until < math.inf for o in observed)):
             kind, motion = self._guard(obs, t_switch, motion, preds if safe is None else safe,
@@ -526,18 +527,16 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         self.pending = (t_switch, motion)
 
     def _retime_path(self, state: RobotState, t_switch: float, path: np.ndarray,
-                     shapes: list[Shape]) -> Trajectory | None:
-        """The timed motion along ``path`` from ``state`` at ``t_switch`` [s], if one exists."""
+                     shapes: list[Shape], ends_s: float | None) -> Trajectory | None:
+        """The timed motion along ``path`` from ``state`` at ``t_switch`` [s], if one exists;
+        when the predictions timed against end (``ends_s`` [s] after they were made), with
+        waits of at most ``ends_s + patience_s``: nothing is left to wait for after that."""
         if not len(path):
             return None
         self._cands = []
         wait = self.max_wait_s
-        if any(o.until < math.inf for o in self._preds):
-            # nothing is left to wait for after the predictions end
-            ends = (self.prediction_horizon_s if self._observed_horizon else
-                    self.announced_horizon_s)
-            if ends is not None:
-                wait = min(wait, ends + self.patience_s)
+        if ends_s is not None and any(o.until < math.inf for o in self._preds):
+            wait = min(wait, ends_s + self.patience_s)
         self._timed_fn(state, t_switch, wait)(np.asarray(path), shapes, 0.0)
         return self._cands[0][1] if self._cands else None
 
