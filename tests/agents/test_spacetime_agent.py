@@ -650,3 +650,35 @@ def test_a_crossing_beyond_the_announced_horizon_is_replanned_and_avoided():
     whole = simulate(_crossing_scenario(), make_agent("st-bitstar", announced_horizon_s=None,
                                                       **_fixed()), seed=0)
     assert not any(x.startswith("collision") for x in whole.extra["reasons"])
+
+
+def test_a_planning_call_books_its_safety_decision_too(monkeypatch):
+    # The guard and the fallbacks are part of the planning call: their time is booked in
+    # planning_times_s (and so in the measured delay of the next calls), as seq-bitstar books
+    # its guard. Here the guard is made 0.2 s slower; a call that ran it books at least that.
+    import time as _time
+
+    from anyplan.agents.spacetime import SpaceTimeBITStarAgent
+    from anyplan.simulation.perception import override_sensing
+
+    slow = 0.2
+    original = SpaceTimeBITStarAgent._guard
+
+    def slow_guard(self, *args, **kwargs):
+        _time.sleep(slow)
+        return original(self, *args, **kwargs)
+
+    monkeypatch.setattr(SpaceTimeBITStarAgent, "_guard", slow_guard)
+    sc = override_sensing(scenario_from_dict({
+        "name": "corridor", "time_limit": 2.0, "arena": {"width": 8.0, "height": 1.2},
+        "robot": {"start": [1.0, 0.6, 0.0], "goal": [7.0, 0.6], **P3DX},
+        "static_obstacles": [],
+        "dynamic_obstacles": [{"name": "H", "start": [6.0, 0.6, math.pi], "v": 0.3,
+                               "radius": 0.3}]}), "twist")
+    agent = make_agent("st-bitstar", guard="horizon", planning_delay=0.1)
+    r = simulate(sc, agent, seed=0)
+    guarded = r.extra["safety_time_s"]
+    assert guarded and min(guarded) >= slow
+    # every call ran the guard here (the obstacle's twist is uncertain under guard="horizon")
+    assert len(r.planning_times_s) == len(guarded)
+    assert all(p >= g for p, g in zip(r.planning_times_s, guarded, strict=True))

@@ -190,33 +190,38 @@ def closest_approach(pos_a: PositionFn, pos_b: PositionFn, rel_speed_bound: floa
     fs = dist(ts)
     i = int(np.argmin(fs))
     best_t, best = float(ts[i]), float(fs[i])
-    intervals = [(ts[j], ts[j + 1], fs[j], fs[j + 1]) for j in range(n)]
+    # the intervals of a level as arrays: starts, ends, distances at both
+    a, b, fa, fb = ts[:-1], ts[1:], fs[:-1], fs[1:]
     evals = n + 1
-
-    def settled(a: float, b: float, fa: float, fb: float) -> bool:
-        """The interval cannot hold a distance below the best by more than L tol, or is fine."""
-        return 0.5 * (fa + fb - L * (b - a)) >= best - L * tol or b - a <= tol
-
-    while intervals and evals < MAX_EVALUATIONS:
-        nxt: list[tuple[float, float, float, float]] = []
-        # The level's points in one evaluation (each position function is called once per level,
-        # not once per interval), for the intervals not settled by the best at the level's
-        # start (the best only decreases); the loop below then takes the same decisions, in the
-        # same order, with the same values as evaluating interval by interval.
-        live = [k for k, iv in enumerate(intervals) if not settled(*iv)]
-        grid = {k: np.linspace(intervals[k][0], intervals[k][1], 5) for k in live}
-        fall = dist(np.concatenate([grid[k][1:-1] for k in live])) if live else np.empty(0)
-        at = {k: 3 * i for i, k in enumerate(live)}
-        for k, (a, b, fa, fb) in enumerate(intervals):
-            if settled(a, b, fa, fb):
-                continue
-            mids = grid[k]
-            fm = fall[at[k]:at[k] + 3]
+    steps = np.arange(1, 4, dtype=float)
+    while len(a) and evals < MAX_EVALUATIONS:
+        # An interval is settled when it cannot hold a distance below the best by more than
+        # L tol, or is fine enough. The level's points are evaluated in one call for the
+        # intervals not settled by the best at the level's start (the best only decreases);
+        # the scan below then takes the same decisions, in the same order, with the same values
+        # as refining interval by interval with the best as it goes.
+        lbs = 0.5 * (fa + fb - L * (b - a))
+        live = np.flatnonzero(~((lbs >= best - L * tol) | (b - a <= tol)))
+        if not len(live):
+            break
+        la, lb, lfa, lfb, llbs = a[live], b[live], fa[live], fb[live], lbs[live]
+        # np.linspace(a, b, 5)'s interior points, bit for bit: k * ((b - a) / 4) + a
+        mids = steps[None, :] * ((lb - la) / 4.0)[:, None] + la[:, None]
+        fm = dist(mids.ravel()).reshape(-1, 3)
+        jm = np.argmin(fm, axis=1)
+        fmin = fm[np.arange(len(live)), jm].tolist()
+        keep = []
+        for k, lo in enumerate(llbs.tolist()):
+            if lo >= best - L * tol:
+                continue  # settled by a better distance found earlier in this level
+            keep.append(k)
             evals += 3
-            j = int(np.argmin(fm))
-            if fm[j] < best:
-                best, best_t = float(fm[j]), float(mids[1 + j])
-            vals = np.concatenate([[fa], fm, [fb]])
-            nxt.extend((mids[m], mids[m + 1], vals[m], vals[m + 1]) for m in range(4))
-        intervals = nxt
+            if fmin[k] < best:
+                best, best_t = fmin[k], float(mids[k, jm[k]])
+        kk = np.asarray(keep, dtype=np.int64)
+        # each refined interval's four parts, in time order
+        pts = np.column_stack([la[kk], mids[kk], lb[kk]])
+        vals = np.column_stack([lfa[kk], fm[kk], lfb[kk]])
+        a, b = pts[:, :-1].ravel(), pts[:, 1:].ravel()
+        fa, fb = vals[:, :-1].ravel(), vals[:, 1:].ravel()
     return best_t, best
