@@ -148,6 +148,24 @@ class FallbackRanker:
         short of that contact; the approach speed of so distant a contact says nothing of what
         the robot will do).
         """
+        head, clear, _ = self.head(tr, t, full, planned, reach, lazy=False)
+        assert clear is not None
+        return (*head, clear), clear
+
+    def head(self, tr: Any, t: float, full: Sequence[PredictedObstacle],
+             planned: Sequence[PredictedObstacle], reach: Sequence[PredictedObstacle] = (),
+             lazy: bool = True) -> tuple[tuple[Any, ...], float | None, float]:
+        """The first six parts of :meth:`rank`'s key (all but the clearance), the clearance
+        [m] against the ``full`` discs when it was computed (None otherwise) and the end [s]
+        of the horizon it is taken over.
+
+        ``lazy``: a candidate the ``planned`` discs strike within the margin is not clear of
+        the full ones by it (they hold the planned ones), so its clearance is not computed
+        when the struck disc's full size at the contact already says so
+        (:meth:`_struck_within_margin`); only a tie on these parts needs it
+        (:func:`_best_ranked`). The clearance search costs about as much as the contact
+        search, and in a crowd most candidates are struck.
+        """
         guard = self.guard
         cfg = guard.config
         h = max(t + cfg.horizon_s, float(tr.t_end), t)
@@ -159,13 +177,34 @@ class FallbackRanker:
                                  margin=cfg.margin, sample_dt=cfg.sample_dt) is None
             # none passively safe: the one at rest soonest (the least exposure while moving)
             passive = (ok, 0.0 if ok else -round(esc.t_rest - t, 2))
-        clear = guard.clearance(tr, full, t, h)
         hit = first_collision(tr, planned, r, t_from=t, t_until=h, margin=cfg.margin,
                               sample_dt=cfg.sample_dt)
+        clear: float | None = None
+        if lazy and hit is not None and self._struck_within_margin(tr, hit, full):
+            clear_ok = False
+        else:
+            clear = guard.clearance(tr, full, t, h)
+            clear_ok = clear >= cfg.margin
         near = hit is not None and float(hit.t) - t < self.react_s
-        return (bool(getattr(tr, "certified_free", True)), passive, clear >= cfg.margin,
+        return (bool(getattr(tr, "certified_free", True)), passive, clear_ok,
                 hit is None, -approach_speed(tr, hit) if near else 0.0,
-                math.inf if hit is None else float(hit.t), clear), clear
+                math.inf if hit is None else float(hit.t)), clear, h
+
+    def _struck_within_margin(self, tr: Any, hit: PredictedCollision,
+                              full: Sequence[PredictedObstacle]) -> bool:
+        """True if the robot at the predicted contact ``hit`` (with a planned disc) is closer
+        than the guard's margin to that obstacle's full disc at its largest, by more than the
+        clearance search's accuracy (relative speed bound x its time tolerance): the
+        clearance :meth:`~anyplan.agents.safety.SafetyGuard.clearance` returns, at most the
+        least distance plus that accuracy, is then below the margin too."""
+        cfg = self.guard.config
+        o = next((o for o in full if o.name == hit.obstacle), None)
+        if o is None:
+            return False
+        gap = (math.hypot(*(np.asarray(hit.robot_position) - np.asarray(hit.obstacle_position)))
+               - self.spec.radius - float(getattr(o, "max_radius", o.radius)))
+        speed = float(tr.max_speed) + max(float(p.max_speed) for p in full)
+        return gap + speed * cfg.tol < cfg.margin
 
     def candidates(self, t: float, state: RobotState, safe: Sequence[PredictedObstacle],
                    motion: Any = None, current: Any = None) -> list[tuple[str, Any]]:
@@ -225,10 +264,23 @@ def _best_ranked(ranker: FallbackRanker, t: float, state: RobotState,
                  full: Sequence[PredictedObstacle], planned: Sequence[PredictedObstacle],
                  motion: Any, current: Any, reach: Sequence[PredictedObstacle]
                  ) -> tuple[tuple[tuple[Any, ...], float], str, Any]:
-    """``((key, clearance [m]), kind, trajectory)`` of the best candidate (the first on a tie)."""
-    ranked = [(ranker.rank(tr, t, full, planned, reach), kind, tr)
-              for kind, tr in ranker.candidates(t, state, full, motion, current)]
-    return max(ranked, key=lambda c: c[0][0])
+    """``((key, clearance [m]), kind, trajectory)`` of the best candidate (the first on a tie):
+    the best of the keys' first parts (:meth:`FallbackRanker.head`), then among the candidates
+    tied there the largest clearance, computed only for them: the same choice as ranking every
+    candidate by its whole key."""
+    heads = [(ranker.head(tr, t, full, planned, reach), kind, tr)
+             for kind, tr in ranker.candidates(t, state, full, motion, current)]
+    top = max(c[0][0] for c in heads)
+    best: tuple[float, str, Any] | None = None
+    for (head, clear, h), kind, tr in heads:
+        if head != top:
+            continue
+        if clear is None:
+            clear = ranker.guard.clearance(tr, full, t, h)
+        if best is None or clear > best[0]:
+            best = (clear, kind, tr)
+    assert best is not None
+    return ((*top, best[0]), best[0]), best[1], best[2]
 
 
 def freer_evasion(ranker: FallbackRanker, t: float, state: RobotState,
@@ -243,7 +295,7 @@ def freer_evasion(ranker: FallbackRanker, t: float, state: RobotState,
     obstacle passes, a collision too (measured on the gap worlds with noise, where a slow robot
     waited in a walker's way). An evasion that no disc strikes is better.
     """
-    k_motion, _ = ranker.rank(motion, t, full, planned, reach)
+    k_motion = ranker.head(motion, t, full, planned, reach)[0]
     (k_best, clear), kind, tr = _best_ranked(ranker, t, state, full, planned, None, None, reach)
     if k_best[:4] <= k_motion[:4]:
         return None

@@ -24,7 +24,7 @@ from typing import Protocol
 import numpy as np
 
 from anyplan.geometry.moving import first_contact, first_contact_growing
-from anyplan.prediction.base import PredictedObstacle
+from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
 from anyplan.world.motion import TrackMotion, UnicycleMotion, WaypointMotion
 
 __all__ = ["TimedMotion", "SampledMotion", "PredictedCollision", "first_collision",
@@ -280,14 +280,10 @@ def _far_from_tracks(obstacles: Sequence[PredictedObstacle], gc: np.ndarray, pc:
     n = len(obstacles)
     if n < 8 or len(gc) < 2:
         return np.zeros(n, dtype=bool)
-    boxes = np.empty((n, 4))
-    lip = np.empty(n)
-    need = np.empty(n)
-    for k, o in enumerate(obstacles):
-        boxes[k], vo = _track(o)
-        rate = 0.0 if o.growth is None else o.growth.rate
-        lip[k] = vr + vo + rate
-        need[k] = reach0 + o.radius + (0.0 if o.growth is None else o.growth.max_extra)
+    stack = _stack(obstacles)
+    boxes = stack.boxes
+    lip = vr + stack.speed + stack.rate
+    need = reach0 + stack.radius + stack.grown
     dx = np.maximum(np.maximum(boxes[None, :, 0] - pc[:, 0, None], pc[:, 0, None] - boxes[None, :, 2]), 0.0)
     dy = np.maximum(np.maximum(boxes[None, :, 1] - pc[:, 1, None], pc[:, 1, None] - boxes[None, :, 3]), 0.0)
     f = np.hypot(dx, dy)  # (coarse times, obstacles); 0 for an unbounded track
@@ -401,26 +397,112 @@ def _straight_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, ou
     uncertified fine interval. Positions are computed here in one pass (a few ulp off
     ``positions``, far below the 1e-9 m allowance); a prediction's horizon (``until``) is
     ignored, which only lowers the bound."""
-    ls = [k for k, o in enumerate(obstacles)
-          if not far[k] and isinstance(o.motion, UnicycleMotion) and o.motion.omega == 0.0]
-    if not ls:
+    stack = _stack(obstacles)
+    sel = np.flatnonzero(~far[stack.straight])  # rows of the straight ones, not far
+    if not len(sel):
         return
-    ms = [obstacles[k].motion for k in ls]
-    x0 = np.array([m.x0 for m in ms])  # type: ignore[attr-defined]
-    y0 = np.array([m.y0 for m in ms])  # type: ignore[attr-defined]
-    th = np.array([m.theta0 for m in ms])  # type: ignore[attr-defined]
-    sp = np.array([m.v for m in ms])  # type: ignore[attr-defined]
-    t_s = np.array([m.start_time for m in ms])  # type: ignore[attr-defined]
+    ls = stack.straight[sel]
+    x0, y0, th, sp, t_s = (a[sel] for a in stack.line)
     tau = np.maximum(gc[None, :] - t_s[:, None], 0.0)  # (obstacles, coarse times)
     ox = x0[:, None] + sp[:, None] * tau * np.cos(th)[:, None]
     oy = y0[:, None] + sp[:, None] * tau * np.sin(th)[:, None]
     d = np.hypot(pc[None, :, 0] - ox, pc[None, :, 1] - oy)
-    rate = np.zeros(len(ls))
-    for i, k in enumerate(ls):
-        g = obstacles[k].growth
-        if g is not None:
-            d[i] -= g.at(gc)
-            rate[i] = g.rate
-    lip = vr + np.abs(sp) + rate
-    out[np.array(ls)] = _first_uncertified(d, lip, np.array([obstacles[k].radius for k in ls]),
-                                           gc, half_fine, reach0)
+    d -= _growth_rows(stack, ls, gc)
+    lip = vr + np.abs(sp) + stack.rate[ls]
+    out[ls] = _first_uncertified(d, lip, stack.radius[ls], gc, half_fine, reach0)
+
+
+@dataclass(frozen=True)
+class _Stack:
+    """One set of predictions as arrays (per obstacle, in order), for the broad phases.
+
+    Attributes:
+        boxes: (n, 4) a box holding each obstacle's centre at all times (:func:`_track`).
+        speed: (n,) the obstacles' speed bounds [m/s].
+        rate: (n,) their growth rates [m/s] (0 without growth).
+        grown: (n,) their largest extra radii [m] (0 without growth).
+        radius: (n,) their radii [m] (without growth).
+        straight: indices of the discs on straight lines (constant twist, omega = 0).
+        line: x0 [m], y0 [m], theta0 [rad], v [m/s], start_time [s] of those, one array each.
+        taus: the growth knots [s] shared by every growing one among them (None when they
+            differ: each is then interpolated on its own).
+    """
+
+    boxes: np.ndarray
+    speed: np.ndarray
+    rate: np.ndarray
+    grown: np.ndarray
+    radius: np.ndarray
+    straight: np.ndarray
+    line: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+    taus: np.ndarray | None
+    t0: np.ndarray  # (n,) each growth's t0 [s] (nan without growth)
+    values: np.ndarray  # (n, K) each growth's values on ``taus`` [m] (when shared)
+    growths: tuple[RadiusGrowth | None, ...]
+
+
+#: Recent :class:`_Stack` records, key the obstacles' ids; the value keeps the obstacles alive
+#: (so that an id seen is the same object). A fallback ranking checks some twenty candidates
+#: against one list of predictions.
+_STACKS: dict[tuple[int, ...], tuple[tuple[PredictedObstacle, ...], _Stack]] = {}
+
+
+def _stack(obstacles: Sequence[PredictedObstacle]) -> _Stack:
+    key = tuple(id(o) for o in obstacles)
+    hit = _STACKS.get(key)
+    if hit is not None and all(a is b for a, b in zip(hit[0], obstacles, strict=True)):
+        return hit[1]
+    n = len(obstacles)
+    boxes, speed = np.empty((n, 4)), np.empty(n)
+    for k, o in enumerate(obstacles):
+        boxes[k], speed[k] = _track(o)
+    growths = [o.growth for o in obstacles]
+    rate = np.array([0.0 if g is None else g.rate for g in growths])
+    grown = np.array([0.0 if g is None else g.max_extra for g in growths])
+    straight = np.array([k for k, o in enumerate(obstacles)
+                         if isinstance(o.motion, UnicycleMotion) and o.motion.omega == 0.0],
+                        dtype=np.int64)
+    ms = [obstacles[k].motion for k in straight]
+    line = tuple(np.array([getattr(m, a) for m in ms], dtype=float)
+                 for a in ("x0", "y0", "theta0", "v", "start_time"))
+    knots = [g.taus for g in growths if g is not None]
+    taus = knots[0] if knots and all(np.array_equal(k, knots[0]) for k in knots) else None
+    t0 = np.array([math.nan if g is None else g.t0 for g in growths])
+    values = np.zeros((n, 0 if taus is None else len(taus)))
+    if taus is not None:
+        for k, g in enumerate(growths):
+            if g is not None:
+                values[k] = g.values
+    out = _Stack(boxes, speed, rate, grown, np.array([o.radius for o in obstacles], dtype=float),
+                 straight, line, taus, t0, values, tuple(growths))  # type: ignore[arg-type]
+    if len(_STACKS) >= 64:
+        _STACKS.clear()
+    _STACKS[key] = (tuple(obstacles), out)
+    return out
+
+
+def _growth_rows(stack: _Stack, rows: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The extra radii (len(rows), len(t)) [m] of the obstacles ``rows`` at times ``t`` [s]
+    (0 without growth): ``RadiusGrowth.at`` row by row, as one interpolation when the knots
+    are shared (the same formula as ``np.interp``: exact but for rounding, far below the
+    bounds' 1e-9 m allowance)."""
+    out = np.zeros((len(rows), len(t)))
+    has = np.flatnonzero(~np.isnan(stack.t0[rows]))
+    if not len(has):
+        return out
+    taus = stack.taus
+    if taus is None or len(taus) < 2:
+        for i in has:
+            out[i] = stack.growths[int(rows[i])].at(t)  # type: ignore[union-attr]
+        return out
+    r = rows[has]
+    tau = t[None, :] - stack.t0[r][:, None]
+    j = np.clip(np.searchsorted(taus, tau.ravel(), side="right") - 1, 0,
+                len(taus) - 2).reshape(tau.shape)
+    v = stack.values[r]
+    ri = np.arange(len(r))[:, None]
+    y0, y1 = v[ri, j], v[ri, j + 1]
+    val = (y1 - y0) / (taus[j + 1] - taus[j]) * (tau - taus[j]) + y0
+    val = np.where(tau <= taus[0], v[:, :1], val)
+    out[has] = np.where(tau >= taus[-1], v[:, -1:], val)
+    return out
