@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from anyplan.agents import AGENTS, make_agent
 from anyplan.experiments.gaps import WALL_T, WALL_X, gap_world, issue_gap_scenario
@@ -682,3 +684,33 @@ def test_a_planning_call_books_its_safety_decision_too(monkeypatch):
     # every call ran the guard here (the obstacle's twist is uncertain under guard="horizon")
     assert len(r.planning_times_s) == len(guarded)
     assert all(p >= g for p, g in zip(r.planning_times_s, guarded, strict=True))
+
+
+@settings(max_examples=12, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(1, 6), v0=st.floats(0.0, 0.4))
+def test_lazy_fallback_ranking_picks_what_ranking_every_candidate_picks(seed, n, v0):
+    # _best_ranked skips the clearance of candidates the planned discs strike within the margin
+    # (FallbackRanker.head) and computes it only on a tie: the same candidate, key and
+    # clearance as ranking every candidate by its whole key (FallbackRanker.rank).
+    from anyplan.agents.evasion import _best_ranked
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.prediction.base import RadiusGrowth
+    from anyplan.world import RobotState, UnicycleMotion
+
+    agent = _agent_in_empty_room()
+    rng = np.random.default_rng(seed)
+    growth = RadiusGrowth(0.0, np.array([0.0, 1.0, 2.0, 4.0]), np.array([0.05, 0.3, 0.6, 1.0]))
+    full = [PredictedObstacle(f"P{k}", 0.25,
+                              UnicycleMotion(*rng.uniform([3.0, 1.5], [9.0, 4.5]),
+                                             rng.uniform(-math.pi, math.pi), rng.uniform(0.2, 1.2)),
+                              growth, until=5.0) for k in range(n)]
+    planned = agent._capped(full)
+    state = RobotState(6.0, 3.0, float(rng.uniform(-math.pi, math.pi)), v0, 0.0)
+    ranker = agent._ranker()
+    (key, clear), kind, tr = _best_ranked(ranker, 0.0, state, full, planned, None, None, ())
+    ranked = [(ranker.rank(c, 0.0, full, planned), k, c)
+              for k, c in ranker.candidates(0.0, state, full)]
+    (k_all, clear_all), kind_all, tr_all = max(ranked, key=lambda c: c[0][0])
+    assert (key, clear, kind) == (k_all, clear_all, kind_all)
+    assert tr.t_end == tr_all.t_end and np.array_equal(tr.positions(np.array([0.5])),
+                                                       tr_all.positions(np.array([0.5])))

@@ -366,3 +366,26 @@ def test_straight_start_bounds_are_lower_bounds_and_change_no_answer(seed, monke
             if len(bad):
                 assert b <= grid[bad[0]], o.name
     assert found > 0
+
+
+def test_growth_of_many_discs_at_once_matches_each_disc():
+    # The broad phase interpolates the growth of every disc in one pass (_growth_rows): the
+    # values of RadiusGrowth.at, disc by disc, up to rounding; before the first knot, between
+    # knots, beyond the cap, without growth, and with knots that differ between discs.
+    from anyplan.prediction.base import RadiusGrowth
+    from anyplan.prediction.collision import _growth_rows, _stack
+    from anyplan.world import UnicycleMotion
+
+    taus = np.array([0.0, 0.5, 1.0, 2.0, 4.0])
+    t = np.linspace(-1.0, 6.0, 57)
+    for other in (taus, np.array([0.0, 1.0, 3.0, 5.0, 6.0])):
+        obs = [PredictedObstacle(f"P{k}", 0.25, UnicycleMotion(k, 0.0, 0.1 * k, 0.5),
+                                 None if k == 2 else RadiusGrowth(
+                                     0.3 * k, other if k == 4 else taus,
+                                     np.cumsum(np.full(5, 0.1 + 0.05 * k))))
+               for k in range(6)]
+        rows = np.arange(6)
+        got = _growth_rows(_stack(obs), rows, t)
+        want = np.array([np.zeros_like(t) if o.growth is None else o.growth.at(t) for o in obs])
+        assert np.allclose(got, want, rtol=0.0, atol=1e-12)
+        assert np.all(got[2] == 0.0)
