@@ -310,7 +310,7 @@ def main(argv: list[str] | None = None) -> int:
     add_agent_options(ap, bench=True)
     args = ap.parse_args(argv)
     try:
-        configs = bench_configs(args, PLANNERS)
+        configs = bench_configs(args, PLANNERS, source="the planners this benchmark drives")
     except SettingsError as exc:  # a bad --set: one line, exit 2
         ap.error(str(exc))
     seeds = args.seeds or (5 if args.quick else 10)

@@ -13,8 +13,9 @@ docs/perception.md), for every planner and peer on the same seeds:
 
 Per (suite, mode, planner): successes, collisions, robot-caused collisions, smallest distance to
 a moving obstacle, discomfort time, time / lower bound, planning time per call (median and 95th
-percentile over all calls). Targets (issue 15) are printed beside the figures. Timings come from
-a shared 2-core machine: read them as rough.
+percentile over all calls; a call's whole wall-clock time, safety guard and fallbacks included,
+since 2026-12-03 for ``st-bitstar``). Targets (issue 15) are printed beside the figures. With
+``--jobs 2`` on a 2-core machine the runs share it: read timings from ``--jobs 1``.
 
 Usage::
 

@@ -101,3 +101,21 @@ def test_other_planners_deterministic_settings_repeat(planner):
             for _ in range(2)]
     assert runs[0].reproducible_dict() == runs[1].reproducible_dict()
     assert len(runs[0].trajectory) > 100
+
+
+def test_a_benchmark_with_fixed_planners_names_them_in_a_bad_set(capsys):
+    # benchmarks/maps.py has no --planners: a --set no planner takes says which planners it
+    # drives, in one line, exit 2 (before anything is compiled or run)
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "maps.py"
+    spec = importlib.util.spec_from_file_location("maps_bench", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    with pytest.raises(SystemExit) as exc:
+        mod.main(["--quick", "--set", "nothing_has_this=1"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "no planner in the planners this benchmark drives (seq-bitstar, st-bitstar)" in err
+    assert "--planners" not in err

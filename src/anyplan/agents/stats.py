@@ -92,7 +92,8 @@ class SequentialStats(StatsRecord):
     Attributes:
         statuses: Count of each replanning status (``collision_free``, ``waiting``, ...).
         iterations: BIT* plans per replanning.
-        late_plans: Replannings whose computation outlasted the expected delay (wall clock).
+        late_plans: Replannings whose computation outlasted the expected delay (wall clock);
+            for ``st-bitstar`` also a decision (guard, fallback) ready after its switch.
         plan_time_s: Wall-clock time [s] of the BIT* searches.
         motion_time_s: Wall-clock time [s] of motion building and prediction.
         replan_times_s: Simulated time [s] of each replanning.

@@ -36,9 +36,12 @@ def run_config(args: argparse.Namespace, planner: str) -> dict[str, Any]:
 
 
 def bench_configs(args: argparse.Namespace, planners: Sequence[str],
-                  base: dict[str, dict[str, Any]] | None = None) -> dict[str, dict[str, Any]]:
+                  base: dict[str, dict[str, Any]] | None = None,
+                  source: str = "--planners") -> dict[str, dict[str, Any]]:
     """Per-planner keyword configs from ``--set [PLANNER:]KEY=VALUE`` and ``--deterministic``,
-    on top of ``base`` (e.g. ``--config``, which the runner checks by building the agent)."""
+    on top of ``base`` (e.g. ``--config``, which the runner checks by building the agent);
+    ``source`` names where the planners come from in the error messages (a benchmark with a
+    fixed list has no ``--planners``)."""
     base = base or {}
     per: dict[str, list[str]] = {p: [] for p in planners}
     for item in args.set_options:
@@ -47,7 +50,7 @@ def bench_configs(args: argparse.Namespace, planners: Sequence[str],
         if sep and colon:
             name = name.strip()
             if name not in per:
-                raise SettingsError(f"--set {item}: planner '{name}' is not in --planners "
+                raise SettingsError(f"--set {item}: planner '{name}' is not in {source} "
                                     f"({', '.join(planners)})")
             per[name].append(item.split(":", 1)[1])
             continue
@@ -57,7 +60,7 @@ def bench_configs(args: argparse.Namespace, planners: Sequence[str],
             if len(planners) == 1:
                 takers = list(planners)  # the unknown-key error, with its hint, comes below
             else:
-                raise SettingsError(f"--set {item}: no planner in --planners ({', '.join(planners)}) "
+                raise SettingsError(f"--set {item}: no planner in {source} ({', '.join(planners)}) "
                                     f"has a setting '{key}'")
         for p in takers:
             per[p].append(item)
