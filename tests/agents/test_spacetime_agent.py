@@ -714,3 +714,43 @@ def test_lazy_fallback_ranking_picks_what_ranking_every_candidate_picks(seed, n,
     assert (key, clear, kind) == (k_all, clear_all, kind_all)
     assert tr.t_end == tr_all.t_end and np.array_equal(tr.positions(np.array([0.5])),
                                                        tr_all.positions(np.array([0.5])))
+
+
+def test_a_safety_decision_ready_after_its_switch_time_is_made_from_the_later_state(monkeypatch):
+    # Measured planning delay, capped at 0.2 s (max_delay_s): a guard that takes 0.3 s cannot
+    # hand over its decision at the switch time planned before it ran. The robot follows its
+    # reference until the decision is ready, and the decision is made again from the state the
+    # robot has then: every motion the guard lets start (or fallback) starts at its switch
+    # time, no earlier than its call plus the guard's 0.3 s, and counts as a late plan.
+    import time as _time
+
+    from anyplan.agents.spacetime import SpaceTimeBITStarAgent
+    from anyplan.simulation.perception import override_sensing
+
+    slow = 0.3
+    original = SpaceTimeBITStarAgent._guard
+    decided: dict[int, float] = {}  # id(trajectory) -> time of the call that decided it
+
+    def slow_guard(self, obs, t_switch, *args, **kwargs):
+        _time.sleep(slow)
+        kind, tr = original(self, obs, t_switch, *args, **kwargs)
+        if kind != "keep":
+            decided[id(tr)] = obs.t
+        return kind, tr
+
+    monkeypatch.setattr(SpaceTimeBITStarAgent, "_guard", slow_guard)
+    sc = override_sensing(scenario_from_dict({
+        "name": "corridor", "time_limit": 3.0, "arena": {"width": 8.0, "height": 1.2},
+        "robot": {"start": [1.0, 0.6, 0.0], "goal": [7.0, 0.6], **P3DX},
+        "static_obstacles": [],
+        "dynamic_obstacles": [{"name": "H", "start": [6.0, 0.6, math.pi], "v": 0.3,
+                               "radius": 0.3}]}), "twist")
+    agent = make_agent("st-bitstar", guard="horizon")  # measured delay
+    agent.max_delay_s = 0.2  # (st-bitstar's cap is its loop's max_time_s, 0.3 s)
+    r = simulate(sc, agent, seed=0)
+    taken = [(t_sw, tr) for t_sw, tr in agent.executed if id(tr) in decided]
+    assert len(taken) >= 2
+    for t_sw, tr in taken:
+        assert t_sw - decided[id(tr)] >= slow - 1e-9  # not before the guard could decide it
+        assert float(tr.t_start) == pytest.approx(t_sw)  # from the state at its switch
+    assert r.extra["late_plans"] >= len(taken)

@@ -188,6 +188,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         self.search_budget_s = None if search_budget_s is None else float(search_budget_s)
         self.improve_budget_s = None if improve_budget_s is None else float(improve_budget_s)
         self._search_deadline: float | None = None
+        self._call_start = 0.0  # wall clock [s] at the start of the replanning call
         self._last_build: float | None = None  # wall clock [s] of the last path built
         if not (isinstance(improve_calls, int) and improve_calls >= 0):
             raise ValueError(f"improve_calls: must be an integer >= 0, got {improve_calls!r}")
@@ -420,16 +421,14 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         ``seq-bitstar`` books its guard. Until 2026-12-03 only the loop and the re-timing were
         booked: on the recorded crowds, ``tracked``, the guard's fallback ranking made the
         calls 10-20 times longer than reported."""
-        w0 = time.perf_counter()
+        w0 = self._call_start = time.perf_counter()
         times = self.stats.planning_times_s
         n, late, pending = len(times), self.record.late_plans, self.pending
         self._replan_call(obs, preds, reason)
         if len(times) > n:
             times[-1] = wall = time.perf_counter() - w0
-            # A decision that outlasted its own switch time is late too (counted once; it
-            # still switches then: the guard and the fallbacks are not redone from the later
-            # state, an approximation that the booked time makes rare, since the next calls'
-            # delay allows for it)
+            # A decision ready after its switch time is late too (counted once; the guard and
+            # the fallbacks decide again from the later state, see _late_decision)
             if (self.planning_delay == "measured" and self.record.late_plans == late
                     and self.pending is not None and self.pending is not pending
                     and wall > self.pending[0] - obs.t + 1e-9):
@@ -514,8 +513,20 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         if (safe is not None and self._guarded_by(safe)) or (
                 self.passive_safety and any(o.until < math.inf for o in observed)):
             g0 = time.perf_counter()
-            kind, motion = self._guard(obs, t_switch, motion, preds if safe is None else safe,
-                                       observed, res.status)
+            full = preds if safe is None else safe
+            marks = len(self.record.fallbacks), len(self.guard.decisions)
+            kind, decided = self._guard(obs, t_switch, motion, full, observed, res.status)
+            late = None if kind == "keep" else self._late_decision(obs, t_switch, dt)
+            if late is not None:
+                # the decision is ready after its switch time, the robot on its reference
+                # meanwhile: decide again from the state it has when the decision is ready
+                del self.record.fallbacks[marks[0]:], self.guard.decisions[marks[1]:]
+                if motion is not None:
+                    motion = self._retime_path(self._state_at(obs, late), late, path, shapes,
+                                               ends_s)
+                t_switch = late
+                kind, decided = self._guard(obs, t_switch, motion, full, observed, res.status)
+            motion = decided
             self.record.safety_time_s.append(time.perf_counter() - g0)
             if kind == "keep":
                 return
@@ -532,7 +543,13 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
                                 t_switch + self.guard.config.horizon_s)) is None:
                 return  # the current reference is still free: keep it, try again later
             g0 = time.perf_counter()
+            mark = len(self.record.fallbacks)
             fb = self._fallback(obs, t_switch, preds, res.status)
+            late = None if fb is None else self._late_decision(obs, t_switch, dt)
+            if late is not None:  # ready after its switch time (as above)
+                del self.record.fallbacks[mark:]
+                t_switch = late
+                fb = self._fallback(obs, t_switch, preds, res.status)
             self.record.safety_time_s.append(time.perf_counter() - g0)
             if fb is None:
                 return  # keeping the motion in use ranks best
@@ -551,6 +568,20 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
                                  "virtual_obstacles": len(res.virtual_obstacles),
                                  "arrival_s": float(motion.t_end)})
         self.pending = (t_switch, motion)
+
+    def _late_decision(self, obs: Observation, t_switch: float, dt: float) -> float | None:
+        """With a measured planning delay, the later switch time [s] (on the control grid of
+        period ``dt`` [s]) of a decision for ``t_switch`` [s] that this call, begun at
+        ``obs.t``, is still computing at ``t_switch``; None when it is ready in time. The
+        robot follows its reference until then, so the decision is made again from the state
+        it has at that time, as a late plan is re-timed (:meth:`_take_up`); the second pass's
+        own time is booked but not charged to the switch, as the re-timing's is not."""
+        if self.planning_delay != "measured":
+            return None
+        elapsed = time.perf_counter() - self._call_start
+        if elapsed <= t_switch - obs.t + 1e-9:
+            return None
+        return obs.t + math.ceil(elapsed / dt - 1e-9) * dt
 
     def _retime_path(self, state: RobotState, t_switch: float, path: np.ndarray,
                      shapes: list[Shape], ends_s: float | None) -> Trajectory | None:
