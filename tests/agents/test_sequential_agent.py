@@ -144,3 +144,51 @@ def test_a_slow_first_plan_keeps_the_robot_at_rest_until_it_is_ready():
     before = tr[tr[:, 0] <= t_start - 0.05 + 1e-9]
     assert np.all(before[:, 4] == 0.0) and np.allclose(before[:, 1:3], sc.robot.start[:2])
     assert res.reached_goal and not res.collision
+
+
+def test_a_safety_decision_ready_after_its_switch_time_is_made_from_the_later_state(monkeypatch):
+    # seq-bitstar, measured planning delay capped at 0.2 s: a guard that takes 0.3 s cannot
+    # hand over its decision at the switch time planned before it ran. The decision is made
+    # again from the state the robot has when it is ready; every one taken starts no earlier
+    # than its call plus the guard's 0.3 s, and counts as a late plan.
+    import math
+    import time
+
+    from anyplan.agents.safety import SafetyGuard
+    from anyplan.simulation.perception import override_sensing
+    from anyplan.world.scenario import scenario_from_dict
+
+    slow = 0.3
+    decide = SafetyGuard.decide
+
+    def slow_decide(self, *args, **kwargs):
+        time.sleep(slow)
+        return decide(self, *args, **kwargs)
+
+    calls: list[tuple[float, object]] = []  # (call time, the decision taken then)
+    replan = SequentialBITStarAgent._replan
+
+    def recorded(self, obs, preds, reason):
+        before = self.pending
+        replan(self, obs, preds, reason)
+        if self.pending is not None and self.pending is not before:
+            calls.append((obs.t, self.pending))
+
+    monkeypatch.setattr(SafetyGuard, "decide", slow_decide)
+    monkeypatch.setattr(SequentialBITStarAgent, "_replan", recorded)
+    p3dx = {"radius": 0.3, "v_max": 0.4, "omega_max": 0.4, "a_max": 0.4, "alpha_max": 1.0,
+            "goal_tolerance": 0.2}
+    sc = override_sensing(scenario_from_dict({
+        "name": "corridor", "time_limit": 2.0, "arena": {"width": 8.0, "height": 1.2},
+        "robot": {"start": [1.0, 0.6, 0.0], "goal": [7.0, 0.6], **p3dx},
+        "static_obstacles": [],
+        "dynamic_obstacles": [{"name": "H", "start": [6.0, 0.6, math.pi], "v": 0.3,
+                               "radius": 0.3}]}), "twist")
+    agent = make_agent("seq-bitstar")  # measured delay, safety guard on
+    agent.max_delay_s = 0.2
+    r = simulate(sc, agent, seed=0)
+    assert calls
+    for t_call, (t_switch, tr) in calls:
+        assert t_switch - t_call >= slow - 1e-9
+        assert float(tr.t_start) == pytest.approx(t_switch)
+    assert r.extra["late_plans"] >= len(calls)

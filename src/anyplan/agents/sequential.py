@@ -14,6 +14,7 @@ behaviour). Moving obstacles are predicted with a constant twist
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Any
 
@@ -105,6 +106,7 @@ class SequentialBITStarAgent(ReplanningAgent):
         self._reset_timing(self._new_record())
         self._fallback_active = False
         self._commit_s = self.check_period_s + 0.1
+        self._call_start, self._late_mark = 0.0, 0  # set by each replanning
 
     def _new_record(self) -> SequentialStats:
         return SequentialStats(fallbacks=self.guard.fallbacks)
@@ -113,7 +115,8 @@ class SequentialBITStarAgent(ReplanningAgent):
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
         dt, d, t_ready, state = self._begin_replan(obs)
         t = obs.t
-        w0 = time.perf_counter()
+        w0 = self._call_start = time.perf_counter()
+        self._late_mark = self.record.late_plans  # a late call counts once
         res: SequentialResult = self.loop.replan(np.array([state.x, state.y]),
                                                  np.asarray(self.spec.goal, dtype=float), preds, t,
                                                  self.reference.departing(state, t_ready))
@@ -129,7 +132,7 @@ class SequentialBITStarAgent(ReplanningAgent):
             rec.progress = [[float(a), float(b)] for a, b in res.history]
         if res.motion is None:
             if self.safety:
-                self._guarded(obs, None, t_ready, d, preds, res)
+                self._guarded(obs, None, t_ready, d, preds, res, dt)
             # Keep the current reference (or stay put); try again after a back-off that doubles
             # with each consecutive failure up to MAX_BACKOFF_S, so that a goal no planning
             # reaches costs a bounded fraction of real time.
@@ -144,7 +147,7 @@ class SequentialBITStarAgent(ReplanningAgent):
                 res.path, [v.shape for v in res.virtual_obstacles], res.delay_s))
         assert motion is not None
         if self.safety:
-            self._guarded(obs, motion, t_switch, t_switch - t, preds, res)
+            self._guarded(obs, motion, t_switch, t_switch - t, preds, res, dt)
             return
         self._record_plan(t, t_switch, res)
         self.pending = (t_switch, motion)
@@ -155,14 +158,32 @@ class SequentialBITStarAgent(ReplanningAgent):
                                  "delay_s": res.delay_s})
 
     def _guarded(self, obs: Observation, motion: Trajectory | None, t_switch: float, delay: float,
-                 preds: list[PredictedObstacle], res: SequentialResult) -> None:
-        """Let the safety guard decide what the robot executes from ``t_switch`` [s]."""
+                 preds: list[PredictedObstacle], res: SequentialResult, dt: float) -> None:
+        """Let the safety guard decide what the robot executes from ``t_switch`` [s]. With the
+        measured delay, a decision that would be ready after ``t_switch`` is made again from the
+        state the robot has when it is ready (the motion re-timed from there), as a late plan
+        is re-timed (:meth:`_take_up`); it counts as a late plan."""
         w0 = time.perf_counter()
+        current = self.trajectory
+        marks = len(self.guard.decisions), len(self.guard.fallbacks)
         # Before the agent can act again: one check period, then a replanning's delay.
         self._commit_s = self.check_period_s + delay
-        current = self.trajectory
-        state = self._state_at(obs, t_switch)
-        dec = self.guard.decide(t_switch, motion, current, state, preds, self._commit_s)
+        dec = self.guard.decide(t_switch, motion, current, self._state_at(obs, t_switch), preds,
+                                self._commit_s)
+        elapsed = time.perf_counter() - self._call_start
+        if (self.planning_delay == "measured" and dec.kind != "keep"
+                and elapsed > t_switch - obs.t + 1e-9):
+            late = obs.t + math.ceil(elapsed / dt - 1e-9) * dt
+            del self.guard.decisions[marks[0]:], self.guard.fallbacks[marks[1]:]
+            state = self._state_at(obs, late)
+            if motion is not None:
+                motion = self.reference.departing(state, late)(
+                    res.path, [v.shape for v in res.virtual_obstacles], res.delay_s)
+            t_switch = late
+            self._commit_s = self.check_period_s + (late - obs.t)
+            dec = self.guard.decide(late, motion, current, state, preds, self._commit_s)
+            if self.record.late_plans == self._late_mark:
+                self.record.late_plans += 1
         wall = time.perf_counter() - w0
         self.stats.planning_times_s[-1] += wall  # the decision is part of the planning call
         self.record.safety_time_s.append(wall)
