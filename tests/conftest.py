@@ -62,3 +62,16 @@ def fast_at_a_wall_dict():
         "dynamic_obstacles": [{"name": "D", "start": [6.0, 7.0, 3.14159], "v": 0.0,
                                "radius": 0.3}],
     }
+
+
+def head_on_corridor_dict(time_limit: float = 20.0):
+    """A 1.2 m corridor, 8 m long, and an obstacle (r 0.3 m, 0.3 m/s) coming head-on along it
+    from x = 6 m towards a P3DX-like robot (r 0.3 m, 0.4 m/s) at x = 1 m: no motion avoids it."""
+    return {
+        "name": "corridor", "time_limit": time_limit, "arena": {"width": 8.0, "height": 1.2},
+        "robot": {"start": [1.0, 0.6, 0.0], "goal": [7.0, 0.6], "radius": 0.3, "v_max": 0.4,
+                  "omega_max": 0.4, "a_max": 0.4, "alpha_max": 1.0, "goal_tolerance": 0.2},
+        "static_obstacles": [],
+        "dynamic_obstacles": [{"name": "H", "start": [6.0, 0.6, 3.141592653589793], "v": 0.3,
+                               "radius": 0.3}],
+    }

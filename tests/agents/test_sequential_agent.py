@@ -151,12 +151,12 @@ def test_a_safety_decision_ready_after_its_switch_time_is_made_from_the_later_st
     # hand over its decision at the switch time planned before it ran. The decision is made
     # again from the state the robot has when it is ready; every one taken starts no earlier
     # than its call plus the guard's 0.3 s, and counts as a late plan.
-    import math
     import time
 
     from anyplan.agents.safety import SafetyGuard
     from anyplan.simulation.perception import override_sensing
     from anyplan.world.scenario import scenario_from_dict
+    from tests.conftest import head_on_corridor_dict
 
     slow = 0.3
     decide = SafetyGuard.decide
@@ -176,14 +176,7 @@ def test_a_safety_decision_ready_after_its_switch_time_is_made_from_the_later_st
 
     monkeypatch.setattr(SafetyGuard, "decide", slow_decide)
     monkeypatch.setattr(SequentialBITStarAgent, "_replan", recorded)
-    p3dx = {"radius": 0.3, "v_max": 0.4, "omega_max": 0.4, "a_max": 0.4, "alpha_max": 1.0,
-            "goal_tolerance": 0.2}
-    sc = override_sensing(scenario_from_dict({
-        "name": "corridor", "time_limit": 2.0, "arena": {"width": 8.0, "height": 1.2},
-        "robot": {"start": [1.0, 0.6, 0.0], "goal": [7.0, 0.6], **p3dx},
-        "static_obstacles": [],
-        "dynamic_obstacles": [{"name": "H", "start": [6.0, 0.6, math.pi], "v": 0.3,
-                               "radius": 0.3}]}), "twist")
+    sc = override_sensing(scenario_from_dict(head_on_corridor_dict(2.0)), "twist")
     agent = make_agent("seq-bitstar")  # measured delay, safety guard on
     agent.max_delay_s = 0.2
     r = simulate(sc, agent, seed=0)

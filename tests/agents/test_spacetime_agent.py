@@ -16,7 +16,7 @@ from anyplan.experiments.gaps import WALL_T, WALL_X, gap_world, issue_gap_scenar
 from anyplan.planning.sequential import SequentialConfig
 from anyplan.simulation import SimConfig, simulate
 from anyplan.world.scenario import scenario_from_dict
-from tests.conftest import fast_at_a_wall_dict
+from tests.conftest import fast_at_a_wall_dict, head_on_corridor_dict
 
 P3DX = {"radius": 0.3, "v_max": 0.4, "omega_max": 0.4, "a_max": 0.4, "alpha_max": 1.0,
         "goal_tolerance": 0.2}
@@ -126,12 +126,7 @@ def test_bad_options():
 @pytest.mark.slow
 def test_holds_and_records_a_fallback_when_nothing_is_safe():
     # A 1.2 m corridor and an obstacle coming head-on along it: no motion avoids it.
-    sc = scenario_from_dict({
-        "name": "corridor", "time_limit": 20.0, "arena": {"width": 8.0, "height": 1.2},
-        "robot": {"start": [1.0, 0.6, 0.0], "goal": [7.0, 0.6], **P3DX},
-        "static_obstacles": [],
-        "dynamic_obstacles": [{"name": "H", "start": [6.0, 0.6, math.pi], "v": 0.3,
-                               "radius": 0.3}]})
+    sc = scenario_from_dict(head_on_corridor_dict(20.0))
     r = simulate(sc, make_agent("st-bitstar", planning_delay=0.1), seed=0)
     fb = r.extra["fallbacks"]
     assert fb and all(f["kind"] in ("hold", "back_off", "evade", "turn_away") for f in fb)
@@ -671,12 +666,7 @@ def test_a_planning_call_books_its_safety_decision_too(monkeypatch):
         return original(self, *args, **kwargs)
 
     monkeypatch.setattr(SpaceTimeBITStarAgent, "_guard", slow_guard)
-    sc = override_sensing(scenario_from_dict({
-        "name": "corridor", "time_limit": 2.0, "arena": {"width": 8.0, "height": 1.2},
-        "robot": {"start": [1.0, 0.6, 0.0], "goal": [7.0, 0.6], **P3DX},
-        "static_obstacles": [],
-        "dynamic_obstacles": [{"name": "H", "start": [6.0, 0.6, math.pi], "v": 0.3,
-                               "radius": 0.3}]}), "twist")
+    sc = override_sensing(scenario_from_dict(head_on_corridor_dict(2.0)), "twist")
     agent = make_agent("st-bitstar", guard="horizon", planning_delay=0.1)
     r = simulate(sc, agent, seed=0)
     guarded = r.extra["safety_time_s"]
@@ -739,12 +729,7 @@ def test_a_safety_decision_ready_after_its_switch_time_is_made_from_the_later_st
         return kind, tr
 
     monkeypatch.setattr(SpaceTimeBITStarAgent, "_guard", slow_guard)
-    sc = override_sensing(scenario_from_dict({
-        "name": "corridor", "time_limit": 3.0, "arena": {"width": 8.0, "height": 1.2},
-        "robot": {"start": [1.0, 0.6, 0.0], "goal": [7.0, 0.6], **P3DX},
-        "static_obstacles": [],
-        "dynamic_obstacles": [{"name": "H", "start": [6.0, 0.6, math.pi], "v": 0.3,
-                               "radius": 0.3}]}), "twist")
+    sc = override_sensing(scenario_from_dict(head_on_corridor_dict(3.0)), "twist")
     agent = make_agent("st-bitstar", guard="horizon")  # measured delay
     agent.max_delay_s = 0.2  # (st-bitstar's cap is its loop's max_time_s, 0.3 s)
     r = simulate(sc, agent, seed=0)
