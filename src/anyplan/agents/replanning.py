@@ -84,6 +84,8 @@ class ReplanningAgent(Agent):
         self._requested: str | None = None
         self.tracking = TrackingLog()
         self.executed: list[tuple[float, Trajectory]] = []  # (switch time [s], trajectory)
+        self._call_start = 0.0  # wall clock [s] at the start of the replanning call
+        self._late_mark = 0  # late_plans at its start (a late call counts once)
 
     # --- timing ----------------------------------------------------------------------------------
     def _expected_delay(self, dt: float) -> float:
@@ -116,9 +118,46 @@ class ReplanningAgent(Agent):
         """The later switch time [s] of a measured replanning that outlasted ``d`` [s] (counted
         in ``late_plans``), or None when it was on time."""
         if self.planning_delay == "measured" and wall > d + 1e-9:
-            self.record.late_plans += 1
+            self._count_late()
             return t + math.ceil(wall / dt - 1e-9) * dt
         return None
+
+    def _count_late(self) -> None:
+        """Count this replanning call in ``late_plans`` (once)."""
+        if self.record.late_plans == self._late_mark:
+            self.record.late_plans += 1
+
+    def _whole_call(self, obs: Observation, call: Callable[[], None]) -> None:
+        """Run one replanning ``call()`` and book its whole wall-clock time in
+        ``planning_times_s`` (and so in the measured delay of the next calls): the planning,
+        a late re-timing, the safety guard and the fallbacks. A decision ready after its own
+        switch time is late too (:meth:`_late_decision`)."""
+        w0 = self._call_start = time.perf_counter()
+        times = self.stats.planning_times_s
+        n, pending = len(times), self.pending
+        self._late_mark = self.record.late_plans
+        call()
+        if len(times) > n:
+            times[-1] = wall = time.perf_counter() - w0
+            if (self.planning_delay == "measured" and self.pending is not None
+                    and self.pending is not pending and wall > self.pending[0] - obs.t + 1e-9):
+                self._count_late()
+
+    def _late_decision(self, obs: Observation, t_switch: float, dt: float) -> float | None:
+        """With a measured planning delay, the later switch time [s] (on the control grid of
+        period ``dt`` [s]) of a decision for ``t_switch`` [s] that this call, begun at
+        ``obs.t``, is still computing at ``t_switch`` (counted in ``late_plans``); None when it
+        is ready in time. The robot follows its reference until then, so the caller makes the
+        decision again from the state it has at that time, as a late plan is re-timed
+        (:meth:`_take_up`); the second pass's own time is booked but not charged to the
+        switch, as the re-timing's is not."""
+        if self.planning_delay != "measured":
+            return None
+        elapsed = time.perf_counter() - self._call_start
+        if elapsed <= t_switch - obs.t + 1e-9:
+            return None
+        self._count_late()
+        return obs.t + math.ceil(elapsed / dt - 1e-9) * dt
 
     def _take_up(self, obs: Observation, t_ready: float, wall: float, d: float, dt: float,
                  motion: Trajectory | None,

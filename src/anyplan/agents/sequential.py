@@ -14,7 +14,6 @@ behaviour). Moving obstacles are predicted with a constant twist
 
 from __future__ import annotations
 
-import math
 import time
 from typing import Any
 
@@ -106,17 +105,19 @@ class SequentialBITStarAgent(ReplanningAgent):
         self._reset_timing(self._new_record())
         self._fallback_active = False
         self._commit_s = self.check_period_s + 0.1
-        self._call_start, self._late_mark = 0.0, 0  # set by each replanning
 
     def _new_record(self) -> SequentialStats:
         return SequentialStats(fallbacks=self.guard.fallbacks)
 
     # --- planning --------------------------------------------------------------------------------
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
+        """One replanning call, booked whole (:meth:`~ReplanningAgent._whole_call`)."""
+        self._whole_call(obs, lambda: self._replan_call(obs, preds, reason))
+
+    def _replan_call(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
         dt, d, t_ready, state = self._begin_replan(obs)
         t = obs.t
-        w0 = self._call_start = time.perf_counter()
-        self._late_mark = self.record.late_plans  # a late call counts once
+        w0 = time.perf_counter()
         res: SequentialResult = self.loop.replan(np.array([state.x, state.y]),
                                                  np.asarray(self.spec.goal, dtype=float), preds, t,
                                                  self.reference.departing(state, t_ready))
@@ -170,10 +171,8 @@ class SequentialBITStarAgent(ReplanningAgent):
         self._commit_s = self.check_period_s + delay
         dec = self.guard.decide(t_switch, motion, current, self._state_at(obs, t_switch), preds,
                                 self._commit_s)
-        elapsed = time.perf_counter() - self._call_start
-        if (self.planning_delay == "measured" and dec.kind != "keep"
-                and elapsed > t_switch - obs.t + 1e-9):
-            late = obs.t + math.ceil(elapsed / dt - 1e-9) * dt
+        late = None if dec.kind == "keep" else self._late_decision(obs, t_switch, dt)
+        if late is not None:
             del self.guard.decisions[marks[0]:], self.guard.fallbacks[marks[1]:]
             state = self._state_at(obs, late)
             if motion is not None:
@@ -182,11 +181,7 @@ class SequentialBITStarAgent(ReplanningAgent):
             t_switch = late
             self._commit_s = self.check_period_s + (late - obs.t)
             dec = self.guard.decide(late, motion, current, state, preds, self._commit_s)
-            if self.record.late_plans == self._late_mark:
-                self.record.late_plans += 1
-        wall = time.perf_counter() - w0
-        self.stats.planning_times_s[-1] += wall  # the decision is part of the planning call
-        self.record.safety_time_s.append(wall)
+        self.record.safety_time_s.append(time.perf_counter() - w0)  # (booked in the call's)
         self.record.safety = self.guard.log()
         if dec.kind == "keep":
             return

@@ -26,9 +26,9 @@ from typing import Any
 import numpy as np
 
 from anyplan.agents.base import Observation
-from anyplan.agents.evasion import FallbackRanker, best_fallback, escape_time_s, freer_evasion
-from anyplan.agents.safety import finite_or_none, reachable_discs
+from anyplan.agents.evasion import escape_time_s
 from anyplan.agents.sequential import SequentialBITStarAgent
+from anyplan.agents.st_fallbacks import SafetyDecisions
 from anyplan.agents.st_predictions import PlanningPredictions
 from anyplan.agents.stats import IMPROVE, SpaceTimeStats
 from anyplan.geometry.shapes import Shape
@@ -59,7 +59,7 @@ def _followable(tr: Any) -> bool:
     return bool(getattr(tr, "feasible", True)) and bool(getattr(tr, "certified_free", True))
 
 
-class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
+class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITStarAgent):
     """BIT* candidate paths, each timed among the moving obstacles (s-t velocity planning).
 
     Args:
@@ -188,7 +188,6 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         self.search_budget_s = None if search_budget_s is None else float(search_budget_s)
         self.improve_budget_s = None if improve_budget_s is None else float(improve_budget_s)
         self._search_deadline: float | None = None
-        self._call_start = 0.0  # wall clock [s] at the start of the replanning call
         self._last_build: float | None = None  # wall clock [s] of the last path built
         if not (isinstance(improve_calls, int) and improve_calls >= 0):
             raise ValueError(f"improve_calls: must be an integer >= 0, got {improve_calls!r}")
@@ -327,112 +326,12 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
         i = int(np.searchsorted(plan.s, s_in))
         return max(0.0, float(plan.t[-1] - plan.t[min(i, len(plan.t) - 1)]))
 
-    def _guard(self, obs: Observation, t_switch: float, motion: Trajectory | None,
-               safe: list[PredictedObstacle], observed: list[PredictedObstacle],
-               reason: str) -> tuple[str, Trajectory | None]:
-        """The safety invariant against the full uncertain predictions ``safe``: start
-        ``motion`` at ``t_switch`` [s] if it is free to rest or stoppable there, else keep the
-        current motion if it still is, else the best of :meth:`_evasions`; a stoppable one
-        gives way to an evasion that is free where it is not (``freer_evasion``). With
-        ``passive_safety``, both must also be passively safe against the reachable discs of
-        the ``observed`` predictions (:meth:`_reach`). Returns the decision's kind and
-        trajectory."""
-        commit = self.check_period_s + max(t_switch - obs.t, 0.0)
-        state = self._state_at(obs, t_switch)
-        reach = self._reach(observed, t_switch, state)
-        # the guard's own fallback is not asked for: _evasions ranks its candidates with more
-        dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit, reach,
-                                fallback=False)
-        if dec.kind in ("motion", "keep"):
-            if dec.rule != "stoppable":
-                return dec.kind, dec.trajectory
-            # stoppable, but struck later: it may stand the robot where the obstacle passes
-            better = freer_evasion(self._ranker(), t_switch, state, safe, self._capped(safe),
-                                   dec.trajectory, reach)
-            if better is None:
-                return dec.kind, dec.trajectory
-            (kind, tr, clear), why = better, (f"{dec.kind}: stoppable, collision predicted at "
-                                              f"{dec.first_collision_s:.2f} s; an evasion is free")
-        else:
-            (kind, tr, clear), why = self._evasions(t_switch, state, safe, motion,
-                                                    self.trajectory, reach), dec.reason or reason
-        self.record.fallbacks.append({"t": float(obs.t), "kind": kind, "reason": why,
-                                      "predicted_clearance_m": finite_or_none(clear)})
-        return kind, tr
-
-    def _reach(self, observed: list[PredictedObstacle], t: float,
-               state: RobotState) -> list[PredictedObstacle]:
-        """The reachable discs at ``t`` [s] of the ``observed`` predictions whose future is
-        unknown (a horizon, no announced motion), with ``passive_safety``; else none."""
-        unknown = [o for o in observed if o.until < math.inf] if self.passive_safety else []
-        if not unknown:
-            return []
-        return reachable_discs(unknown, t, np.array([state.x, state.y]), state.theta,
-                               self.reach_extra_mps, self.guard.config.horizon_s,
-                               self.reach_min_speed_mps)
-
-    def _evasions(self, t: float, state: RobotState, safe: list[PredictedObstacle],
-                  motion: Trajectory | None, current: Trajectory | None = None,
-                  reach: Sequence[PredictedObstacle] = ()) -> tuple[str, Any, float]:
-        """The best fallback from ``state`` at ``t`` [s], with its clearance [m]:
-        :func:`anyplan.agents.evasion.best_fallback` against the full predictions ``safe``
-        and the capped ones planned against, ``reach`` with ``passive_safety``."""
-        return best_fallback(self._ranker(), t, state, safe, self._capped(safe), motion,
-                             current, reach)
-
-    def _fallback_rank(self, tr: Any, t: float, full: list[PredictedObstacle],
-                       planned: list[PredictedObstacle], reach: Sequence[PredictedObstacle] = ()
-                       ) -> tuple[tuple[Any, ...], float]:
-        """The ranking key of fallback ``tr`` (:meth:`FallbackRanker.rank
-        <anyplan.agents.evasion.FallbackRanker.rank>`) and its clearance [m]."""
-        return self._ranker().rank(tr, t, full, planned, reach)
-
-    def _ranker(self) -> FallbackRanker:
-        return FallbackRanker(self.spec, self.obstacles, self.guard, self.check_period_s)
-
-    def _fallback(self, obs: Observation, t_switch: float, preds: list[PredictedObstacle],
-                  reason: str) -> Trajectory | None:
-        """No motion was found and the one in use is no longer free (certain predictions, no
-        guard): the best fallback of :meth:`_evasions` (brake or hold, turn away, back off,
-        evade, or keep the motion in use when strictly better), ranked by predicted clearance,
-        never a blind brake. Before, braking on the current reference was the only fallback:
-        in DynaBARN world 58 (``twist``) the robot braked straight into the path of an
-        obstacle that had just turned, its collision predicted 0.9 s ahead, while turning away
-        was free. Returns None to keep the motion in use."""
-        state = self._state_at(obs, t_switch)
-        if not preds:
-            tr, _ = self.reference.hold(state, t_switch, 1e4, kind=MotionKind.FALLBACK_HOLD,
-                                        stop_rotation=False)
-            kind, clear = "brake-hold", math.inf
-        else:
-            kind, tr, clear = self._evasions(t_switch, state, preds, None, self.trajectory)
-        if kind == "keep":
-            return None
-        self.record.fallbacks.append(
-            {"t": float(obs.t), "kind": kind, "reason": reason,
-             "predicted_clearance_m": finite_or_none(clear)})
-        return tr
-
     # --- planning --------------------------------------------------------------------------------
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
-        """One replanning call. Its wall-clock time, booked in ``planning_times_s`` (and so in
-        the measured planning delay of the next calls), is the whole call's: the predictions'
-        split, the loop, a late re-timing, the safety guard and the fallbacks, as
-        ``seq-bitstar`` books its guard. Until 2026-12-03 only the loop and the re-timing were
-        booked: on the recorded crowds, ``tracked``, the guard's fallback ranking made the
-        calls 10-20 times longer than reported."""
-        w0 = self._call_start = time.perf_counter()
-        times = self.stats.planning_times_s
-        n, late, pending = len(times), self.record.late_plans, self.pending
-        self._replan_call(obs, preds, reason)
-        if len(times) > n:
-            times[-1] = wall = time.perf_counter() - w0
-            # A decision ready after its switch time is late too (counted once; the guard and
-            # the fallbacks decide again from the later state, see _late_decision)
-            if (self.planning_delay == "measured" and self.record.late_plans == late
-                    and self.pending is not None and self.pending is not pending
-                    and wall > self.pending[0] - obs.t + 1e-9):
-                self.record.late_plans += 1
+        """One replanning call, booked whole (:meth:`~ReplanningAgent._whole_call`). Until
+        2026-12-03 only the loop and the re-timing were booked: on the recorded crowds
+        (``tracked``) the guard's fallback ranking made calls 10-20 times longer than reported."""
+        self._whole_call(obs, lambda: self._replan_call(obs, preds, reason))
 
     def _replan_call(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
         dt, d, t_ready, state = self._begin_replan(obs)
@@ -568,20 +467,6 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SequentialBITStarAgent):
                                  "virtual_obstacles": len(res.virtual_obstacles),
                                  "arrival_s": float(motion.t_end)})
         self.pending = (t_switch, motion)
-
-    def _late_decision(self, obs: Observation, t_switch: float, dt: float) -> float | None:
-        """With a measured planning delay, the later switch time [s] (on the control grid of
-        period ``dt`` [s]) of a decision for ``t_switch`` [s] that this call, begun at
-        ``obs.t``, is still computing at ``t_switch``; None when it is ready in time. The
-        robot follows its reference until then, so the decision is made again from the state
-        it has at that time, as a late plan is re-timed (:meth:`_take_up`); the second pass's
-        own time is booked but not charged to the switch, as the re-timing's is not."""
-        if self.planning_delay != "measured":
-            return None
-        elapsed = time.perf_counter() - self._call_start
-        if elapsed <= t_switch - obs.t + 1e-9:
-            return None
-        return obs.t + math.ceil(elapsed / dt - 1e-9) * dt
 
     def _retime_path(self, state: RobotState, t_switch: float, path: np.ndarray,
                      shapes: list[Shape], ends_s: float | None) -> Trajectory | None:
