@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
@@ -159,6 +159,26 @@ class ReplanningAgent(Agent):
         self._count_late()
         return obs.t + math.ceil(elapsed / dt - 1e-9) * dt
 
+    def _decide_in_time(self, obs: Observation, t_switch: float, dt: float,
+                        decide: Callable[[float], tuple[Any, bool]],
+                        logs: Sequence[list[Any]]) -> tuple[float, Any]:
+        """A safety decision for the switch at ``t_switch`` [s]: ``decide(t_s)`` returns the
+        decision for a switch at ``t_s`` and whether it switches anything. One that would be
+        ready after ``t_switch`` (:meth:`_late_decision`) is made again for the later switch
+        time, what the first pass appended to ``logs`` dropped. Its time goes to
+        ``safety_time_s``. Returns (switch time [s], decision)."""
+        g0 = time.perf_counter()
+        marks = [len(log) for log in logs]
+        out, switches = decide(t_switch)
+        late = self._late_decision(obs, t_switch, dt) if switches else None
+        if late is not None:
+            for log, mark in zip(logs, marks, strict=True):
+                del log[mark:]
+            t_switch = late
+            out, _ = decide(late)
+        self.record.safety_time_s.append(time.perf_counter() - g0)
+        return t_switch, out
+
     def _take_up(self, obs: Observation, t_ready: float, wall: float, d: float, dt: float,
                  motion: Trajectory | None,
                  retime: Callable[[RobotState, float], Trajectory | None]
@@ -166,14 +186,12 @@ class ReplanningAgent(Agent):
         """When and what the robot takes up: ``motion`` at ``t_ready`` [s]; or, when the
         replanning (``wall`` [s]) outlasted the expected delay ``d`` [s], ``retime(state,
         t_switch)`` from the state the robot will have at the later switch time (the robot went
-        on with its current reference meanwhile; the re-timing counts as planning time)."""
+        on with its current reference meanwhile; the re-timing is booked with the whole call,
+        :meth:`_whole_call`)."""
         late = self._late_switch(obs.t, wall, d, dt)
         if late is None:
             return t_ready, motion
-        w1 = time.perf_counter()
-        out = retime(self._state_at(obs, late), late)
-        self.stats.planning_times_s[-1] = wall + (time.perf_counter() - w1)
-        return late, out
+        return late, retime(self._state_at(obs, late), late)
 
     def _record_replan(self, t: float, wall: float, res: Any, reason: str) -> None:
         """Book one replanning at ``t`` [s] that took ``wall`` [s] with result ``res`` (a

@@ -164,24 +164,19 @@ class SequentialBITStarAgent(ReplanningAgent):
         measured delay, a decision that would be ready after ``t_switch`` is made again from the
         state the robot has when it is ready (the motion re-timed from there), as a late plan
         is re-timed (:meth:`_take_up`); it counts as a late plan."""
-        w0 = time.perf_counter()
-        current = self.trajectory
-        marks = len(self.guard.decisions), len(self.guard.fallbacks)
-        # Before the agent can act again: one check period, then a replanning's delay.
-        self._commit_s = self.check_period_s + delay
-        dec = self.guard.decide(t_switch, motion, current, self._state_at(obs, t_switch), preds,
-                                self._commit_s)
-        late = None if dec.kind == "keep" else self._late_decision(obs, t_switch, dt)
-        if late is not None:
-            del self.guard.decisions[marks[0]:], self.guard.fallbacks[marks[1]:]
-            state = self._state_at(obs, late)
-            if motion is not None:
-                motion = self.reference.departing(state, late)(
-                    res.path, [v.shape for v in res.virtual_obstacles], res.delay_s)
-            t_switch = late
-            self._commit_s = self.check_period_s + (late - obs.t)
-            dec = self.guard.decide(late, motion, current, state, preds, self._commit_s)
-        self.record.safety_time_s.append(time.perf_counter() - w0)  # (booked in the call's)
+        current, planned = self.trajectory, t_switch
+
+        def decide(t_s: float) -> tuple[Any, bool]:
+            # Before the agent can act again: one check period, then a replanning's delay.
+            self._commit_s = self.check_period_s + (delay if t_s == planned else t_s - obs.t)
+            state = self._state_at(obs, t_s)
+            m = motion if t_s == planned or motion is None else self.reference.departing(
+                state, t_s)(res.path, [v.shape for v in res.virtual_obstacles], res.delay_s)
+            dec = self.guard.decide(t_s, m, current, state, preds, self._commit_s)
+            return dec, dec.kind != "keep"
+
+        t_switch, dec = self._decide_in_time(obs, t_switch, dt, decide,
+                                             (self.guard.decisions, self.guard.fallbacks))
         self.record.safety = self.guard.log()
         if dec.kind == "keep":
             return

@@ -411,27 +411,21 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             lambda state, t_s: self._retime_path(state, t_s, path, shapes, ends_s))
         if (safe is not None and self._guarded_by(safe)) or (
                 self.passive_safety and any(o.until < math.inf for o in observed)):
-            g0 = time.perf_counter()
-            full = preds if safe is None else safe
-            marks = len(self.record.fallbacks), len(self.guard.decisions)
-            kind, decided = self._guard(obs, t_switch, motion, full, observed, res.status)
-            late = None if kind == "keep" else self._late_decision(obs, t_switch, dt)
-            if late is not None:
-                # the decision is ready after its switch time, the robot on its reference
-                # meanwhile: decide again from the state it has when the decision is ready
-                del self.record.fallbacks[marks[0]:], self.guard.decisions[marks[1]:]
-                if motion is not None:
-                    motion = self._retime_path(self._state_at(obs, late), late, path, shapes,
-                                               ends_s)
-                t_switch = late
-                kind, decided = self._guard(obs, t_switch, motion, full, observed, res.status)
-            motion = decided
-            self.record.safety_time_s.append(time.perf_counter() - g0)
+            full, planned, proposed = (preds if safe is None else safe), t_switch, motion
+
+            def guarded(t_s: float) -> tuple[Any, bool]:
+                m = proposed if t_s == planned or proposed is None else self._retime_path(
+                    self._state_at(obs, t_s), t_s, path, shapes, ends_s)
+                kind, tr = self._guard(obs, t_s, m, full, observed, res.status)
+                return (kind, tr), kind != "keep"
+
+            t_switch, (kind, motion) = self._decide_in_time(
+                obs, t_switch, dt, guarded, (self.record.fallbacks, self.guard.decisions))
             if kind == "keep":
                 return
             if kind != "motion":
                 self._fallback_active = True
-                self.pending = (t_switch, motion)  # type: ignore[assignment]
+                self.pending = (t_switch, motion)
                 return
         if motion is None:
             # (checked at least the fallback horizon ahead: a motion that has ended leaves the
@@ -441,15 +435,13 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
                     t_until=max(min(self.trajectory.t_end, t_switch + _CHECK_HORIZON_S),
                                 t_switch + self.guard.config.horizon_s)) is None:
                 return  # the current reference is still free: keep it, try again later
-            g0 = time.perf_counter()
-            mark = len(self.record.fallbacks)
-            fb = self._fallback(obs, t_switch, preds, res.status)
-            late = None if fb is None else self._late_decision(obs, t_switch, dt)
-            if late is not None:  # ready after its switch time (as above)
-                del self.record.fallbacks[mark:]
-                t_switch = late
-                fb = self._fallback(obs, t_switch, preds, res.status)
-            self.record.safety_time_s.append(time.perf_counter() - g0)
+
+            def fallback(t_s: float) -> tuple[Any, bool]:
+                fb = self._fallback(obs, t_s, preds, res.status)
+                return fb, fb is not None
+
+            t_switch, fb = self._decide_in_time(obs, t_switch, dt, fallback,
+                                                (self.record.fallbacks,))
             if fb is None:
                 return  # keeping the motion in use ranks best
             self._fallback_active = True

@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import heapq
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -293,27 +293,37 @@ def _far_from_tracks(obstacles: Sequence[PredictedObstacle], gc: np.ndarray, pc:
         return lb > need + 0.5 * lip * float(dt.max()) + 1e-9 * (1.0 + need + lip)
 
 
-#: The keyframes of recent sets of pacing tracks, padded to one length (``_padded``): key the
-#: motions' ids, value (the motions, kept alive so that an id is not reused, the stack).
-_PADDED: dict[tuple[int, ...], tuple[tuple[object, ...], np.ndarray, np.ndarray]] = {}
+#: The keyframes of recent sets of pacing tracks, padded to one length (``_padded``).
+_PADDED: dict[tuple[int, ...], tuple[tuple[object, ...], Any]] = {}
+
+
+def _by_identity(cache: dict[tuple[int, ...], tuple[tuple[object, ...], Any]],
+                 items: Sequence[object], build: Callable[[], Any]) -> Any:
+    """``build()``, memoised in ``cache`` by the identity of ``items`` (the entry keeps them
+    alive, so that an id seen is the same object); at most 64 entries."""
+    key = tuple(id(x) for x in items)
+    hit = cache.get(key)
+    if hit is not None and all(a is b for a, b in zip(hit[0], items, strict=True)):
+        return hit[1]
+    out = build()
+    if len(cache) >= 64:
+        cache.clear()
+    cache[key] = (tuple(items), out)
+    return out
 
 
 def _padded(motions: Sequence[WaypointMotion]) -> tuple[np.ndarray, np.ndarray]:
     """The keyframes of ``motions`` stacked (n, K, 3) with K the longest, the rows past a
     track's own end at time +inf (never <= a time), and each track's keyframe count (n,)."""
-    key = tuple(id(m) for m in motions)
-    hit = _PADDED.get(key)
-    if hit is not None and all(a is b for a, b in zip(hit[0], motions, strict=True)):
-        return hit[1], hit[2]
-    lens = np.array([len(m.keyframes) for m in motions], dtype=np.int64)
-    kf = np.zeros((len(motions), int(lens.max()), 3))
-    kf[:, :, 0] = math.inf
-    for j, m in enumerate(motions):
-        kf[j, :lens[j]] = m.keyframes
-    if len(_PADDED) >= 64:
-        _PADDED.clear()
-    _PADDED[key] = (tuple(motions), kf, lens)
-    return kf, lens
+    def build() -> tuple[np.ndarray, np.ndarray]:
+        lens = np.array([len(m.keyframes) for m in motions], dtype=np.int64)
+        kf = np.zeros((len(motions), int(lens.max()), 3))
+        kf[:, :, 0] = math.inf
+        for j, m in enumerate(motions):
+            kf[j, :lens[j]] = m.keyframes
+        return kf, lens
+
+    return _by_identity(_PADDED, motions, build)
 
 
 def _start_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, grid: np.ndarray,
@@ -441,17 +451,17 @@ class _Stack:
     growths: tuple[RadiusGrowth | None, ...]
 
 
-#: Recent :class:`_Stack` records, key the obstacles' ids; the value keeps the obstacles alive
-#: (so that an id seen is the same object). A fallback ranking checks some twenty candidates
-#: against one list of predictions.
-_STACKS: dict[tuple[int, ...], tuple[tuple[PredictedObstacle, ...], _Stack]] = {}
+#: Recent :class:`_Stack` records (``_stack``). A fallback ranking checks some twenty
+#: candidates against one list of predictions.
+_STACKS: dict[tuple[int, ...], tuple[tuple[object, ...], Any]] = {}
 
 
 def _stack(obstacles: Sequence[PredictedObstacle]) -> _Stack:
-    key = tuple(id(o) for o in obstacles)
-    hit = _STACKS.get(key)
-    if hit is not None and all(a is b for a, b in zip(hit[0], obstacles, strict=True)):
-        return hit[1]
+    """The :class:`_Stack` of ``obstacles`` (memoised by their identity)."""
+    return _by_identity(_STACKS, obstacles, lambda: _build_stack(obstacles))
+
+
+def _build_stack(obstacles: Sequence[PredictedObstacle]) -> _Stack:
     n = len(obstacles)
     boxes, speed = np.empty((n, 4)), np.empty(n)
     for k, o in enumerate(obstacles):
@@ -473,12 +483,8 @@ def _stack(obstacles: Sequence[PredictedObstacle]) -> _Stack:
         for k, g in enumerate(growths):
             if g is not None:
                 values[k] = g.values
-    out = _Stack(boxes, speed, rate, grown, np.array([o.radius for o in obstacles], dtype=float),
-                 straight, line, taus, t0, values, tuple(growths))  # type: ignore[arg-type]
-    if len(_STACKS) >= 64:
-        _STACKS.clear()
-    _STACKS[key] = (tuple(obstacles), out)
-    return out
+    return _Stack(boxes, speed, rate, grown, np.array([o.radius for o in obstacles], dtype=float),
+                  straight, line, taus, t0, values, tuple(growths))  # type: ignore[arg-type]
 
 
 def _growth_rows(stack: _Stack, rows: np.ndarray, t: np.ndarray) -> np.ndarray:
