@@ -107,3 +107,39 @@ def test_the_default_cover_proves_all_that_half_radius_cells_prove(seed):
         if old:
             assert provably_disconnected(obs, s, g, r)
     assert old_proofs
+
+
+def test_a_maps_kept_cell_tests_give_the_answers_of_testing_the_whole_set():
+    # On an indexed map the boxes' cell tests are kept across calls and combined with the
+    # squares' (tested only near their boxes): every mask equals the direct test of the whole
+    # set, for squares and circles that change from call to call as a replanning's do.
+    from anyplan.geometry import Circle
+    from anyplan.geometry.cells import cell_boxes, merge_cells
+    from anyplan.planning import connectivity as cn
+
+    rng = np.random.default_rng(7)
+    occ = rng.random((40, 48)) < 0.25
+    boxes = cell_boxes(merge_cells(occ), (0.0, 0.0), 0.25)
+    world = ObstacleSet([rectangle((3.0, 3.0), (0.4, 0.4))], bounds=(0.0, 0.0, 12.0, 10.0),
+                        boxes=boxes)
+    assert world.indexed
+    cn._MASKS.clear(), cn._FINE.clear()
+    for call in range(6):
+        extra = [rectangle(tuple(rng.uniform((1.0, 1.0), (11.0, 9.0))),
+                           tuple(rng.uniform(0.3, 1.5, 2))) for _ in range(call % 3)]
+        extra += [Circle(tuple(rng.uniform((1.0, 1.0), (11.0, 9.0))), 0.4)] * (call % 2)
+        obs = world.with_shapes(extra)
+        assert obs.split_boxes()[0] is world.split_boxes()[0]  # one base, so one memo
+        h, nx, ny = 0.3, 40, 34
+        centres = cn._centres(0.0, 0.0, h, nx, ny)
+        cover = cn._Cover(obs, 0.0, 0.0, h, nx, ny, centres)
+        for limit in (0.1, 0.35):
+            assert np.array_equal(cover.clear(limit),
+                                  obs.points_clear(centres, limit).reshape(ny, nx))
+        near = rng.random((ny, nx)) < 0.3
+        fine = np.zeros((ny * 4, nx * 4), dtype=bool)
+        cover.refine(fine, near, 4, 0.12)
+        fi, fj = cn._fine_cells(near, 4)
+        pts = np.column_stack([(fj + 0.5) * h / 4, (fi + 0.5) * h / 4])
+        assert np.array_equal(fine[fi, fj], obs.points_clear(pts, 0.12))
+        assert not fine[~np.repeat(np.repeat(near, 4, axis=0), 4, axis=1)].any()

@@ -71,6 +71,11 @@ def _boxes_digest(boxes: np.ndarray) -> bytes:
     return d
 
 
+#: Recent sets of boxes and walls alone (:meth:`ObstacleSet.split_boxes`), with their boxes
+#: array (kept alive here, so that an id seen is the same array) and (walls, index choice).
+_BOX_SETS: list[tuple[np.ndarray, tuple[object, object], ObstacleSet]] = []
+
+
 class ObstacleSet:
     """Static obstacles (circles, polygons, axis-aligned boxes) plus optional arena walls.
 
@@ -182,6 +187,21 @@ class ObstacleSet:
         out._gmeta, out._gcsr = self._gmeta, self._gcsr
         out._pack()
         return out
+
+    def split_boxes(self) -> tuple[ObstacleSet, ObstacleSet]:
+        """(the boxes with the walls, the shapes alone): the clearance of this set is the
+        smaller of theirs, so a point is clear of it to a limit iff it is clear of both.
+
+        The first set is the same object for every set that shares this one's boxes array,
+        walls and index choice (the sets :meth:`with_shapes` makes from one map): a memo keyed
+        by its :attr:`fingerprint` serves all of them, and its grid index is built once."""
+        key = (self.bounds, self._index)
+        base = next((s for b, k_, s in _BOX_SETS if b is self.boxes and k_ == key), None)
+        if base is None:
+            base = ObstacleSet((), self.bounds, boxes=self.boxes, index=self._index)
+            _BOX_SETS.append((self.boxes, key, base))
+            del _BOX_SETS[:-4]
+        return base, ObstacleSet(self.shapes)
 
     @property
     def arrays(self) -> ObstacleArrays:

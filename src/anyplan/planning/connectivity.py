@@ -17,6 +17,8 @@ flood fills, whatever the number of obstacles, unlike the visibility graph's low
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -81,10 +83,15 @@ def provably_disconnected(obstacles: ObstacleSet, start: np.ndarray | tuple[floa
     nx, ny = max(1, math.ceil(w / h)), max(1, math.ceil(h_ / h))
     centres = _centres(x0, y0, h, nx, ny)
     # one exact clearance per cell when the set is small; on an indexed map, pass/fail
-    # queries, which stop early, are cheaper even twice
-    dist = None if obstacles.indexed else obstacles.clearances(centres).reshape(ny, nx)
-    open_ = np.ascontiguousarray(dist >= limit if dist is not None else
-                                 obstacles.points_clear(centres, limit).reshape(ny, nx))
+    # queries, which stop early, are cheaper even twice, and the map's own part is kept
+    # across the calls of a replanning loop (_Cover: about 12 ms a call to 2 ms in the office)
+    cover = _Cover(obstacles, x0, y0, h, nx, ny, centres) if obstacles.indexed else None
+    if cover is None:
+        dist = obstacles.clearances(centres).reshape(ny, nx)
+        clear: Callable[[float], np.ndarray] = lambda lim: dist >= lim  # noqa: E731
+    else:
+        clear = cover.clear
+    open_ = np.ascontiguousarray(clear(limit))
     a, b = _cell_of(start, x0, y0, h, nx, ny), _cell_of(goal, x0, y0, h, nx, ny)
     # a point on a cell border also belongs to the neighbour: only conclude when the
     # endpoints' own cells are open and not joined
@@ -97,8 +104,7 @@ def provably_disconnected(obstacles: ObstacleSet, start: np.ndarray | tuple[floa
         return False
     # the cells neither blocked nor wholly free (centre clearance below radius + half) are
     # split; on the nested finer grid every cell the coarse cover would block stays blocked
-    free = np.ascontiguousarray(dist >= radius + half if dist is not None else
-                                obstacles.points_clear(centres, radius + half).reshape(ny, nx))
+    free = np.ascontiguousarray(clear(radius + half))
     if connected8(free, a[0], a[1], b[0], b[1]):
         return False  # a chain of wholly free cells joins them: a path exists
     near = open_ & ~free
@@ -112,16 +118,104 @@ def provably_disconnected(obstacles: ObstacleSet, start: np.ndarray | tuple[floa
     hf = h / k
     fine_limit = radius - hf * math.sqrt(2.0) / 2.0 - 1e-9
     fine = np.repeat(np.repeat(open_, k, axis=0), k, axis=1)
-    rows, cols = np.nonzero(near)
-    di, dj = np.divmod(np.arange(k * k), k)
-    fi = (rows[:, None] * k + di[None, :]).ravel()
-    fj = (cols[:, None] * k + dj[None, :]).ravel()
-    pts = np.column_stack([x0 + (fj + 0.5) * hf, y0 + (fi + 0.5) * hf])
-    fine[fi, fj] = obstacles.points_clear(pts, fine_limit)
+    if cover is None:
+        fi, fj = _fine_cells(near, k)
+        pts = np.column_stack([x0 + (fj + 0.5) * hf, y0 + (fi + 0.5) * hf])
+        fine[fi, fj] = obstacles.points_clear(pts, fine_limit)
+    else:
+        cover.refine(fine, near, k, fine_limit)
     fine = np.ascontiguousarray(fine)
     fa = _cell_of(start, x0, y0, hf, nx * k, ny * k)
     fb = _cell_of(goal, x0, y0, hf, nx * k, ny * k)
     return bool(fine[fa] and fine[fb] and not connected8(fine, fa[0], fa[1], fb[0], fb[1]))
+
+
+def _fine_cells(near: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """(rows, columns) of the k x k fine cells of each coarse cell marked in ``near``."""
+    rows, cols = np.nonzero(near)
+    di, dj = np.divmod(np.arange(k * k), k)
+    return (rows[:, None] * k + di[None, :]).ravel(), (cols[:, None] * k + dj[None, :]).ravel()
+
+
+#: Recent pass/fail masks of a map's boxes and walls (:class:`_Cover`), by cover and limit.
+_MASKS: dict[tuple[object, ...], np.ndarray] = {}
+#: Recent fine masks of a map's boxes and walls, and which coarse cells they hold (_Cover.refine).
+_FINE: dict[tuple[object, ...], tuple[np.ndarray, np.ndarray]] = {}
+_MEMO_SIZE = 4
+
+
+def _remember(memo: dict[tuple[object, ...], Any], key: tuple[object, ...], value: Any) -> None:
+    memo[key] = value
+    while len(memo) > _MEMO_SIZE:
+        del memo[next(iter(memo))]
+
+
+class _Cover:
+    """The pass/fail clearance tests of a cover on an indexed map. A map's boxes and walls are
+    the same in every call of a replanning loop, only its virtual squares change: their cells'
+    tests are kept (by the boxes' fingerprint) and combined with those of the shapes, the few
+    squares, which are scanned linearly (clearance is the least over the parts, so a point is
+    clear of the whole set iff it is clear of both: the same answers as testing the whole)."""
+
+    def __init__(self, obstacles: ObstacleSet, x0: float, y0: float, h: float, nx: int, ny: int,
+                 centres: np.ndarray) -> None:
+        self.base, self.shapes = obstacles.split_boxes()
+        self.key = (self.base.fingerprint, x0, y0, h, nx, ny)
+        self.x0, self.y0, self.h, self.nx, self.ny = x0, y0, h, nx, ny
+        self.centres = centres
+
+    def clear(self, limit: float) -> np.ndarray:
+        """(ny, nx): the cells whose centre has clearance >= ``limit`` [m]."""
+        key = (*self.key, limit)
+        mask = _MASKS.get(key)
+        if mask is None:
+            mask = self.base.points_clear(self.centres, limit).reshape(self.ny, self.nx)
+            _remember(_MASKS, key, mask)
+        out = mask.copy()
+        at = np.flatnonzero(out)
+        out.ravel()[at] = self._clear_of_shapes(self.centres[at], limit)
+        return out
+
+    def _clear_of_shapes(self, pts: np.ndarray, limit: float) -> np.ndarray:
+        """Mask (N,): clearance from the shapes >= ``limit`` [m]. A point farther than
+        ``limit`` from every shape's bounding box is clear of it (the box holds the shape);
+        the others get the exact test."""
+        out = np.ones(len(pts), dtype=bool)
+        c = self.shapes.circles
+        boxes = np.vstack([self.shapes.pbox, np.column_stack([c[:, :2] - c[:, 2:], c[:, :2] + c[:, 2:]])])
+        if len(boxes) == 0 or len(pts) == 0:
+            return out
+        x, y = pts[:, 0:1], pts[:, 1:2]
+        near = ((x >= boxes[:, 0] - limit) & (x <= boxes[:, 2] + limit)
+                & (y >= boxes[:, 1] - limit) & (y <= boxes[:, 3] + limit)).any(axis=1)
+        at = np.flatnonzero(near)
+        if len(at):
+            out[at] = self.shapes.points_clear(pts[at], limit)
+        return out
+
+    def refine(self, fine: np.ndarray, near: np.ndarray, k: int, limit: float) -> None:
+        """Set the k x k fine cells of each ``near`` coarse cell in ``fine`` to their centres'
+        test at ``limit`` [m] (clearance >= limit)."""
+        key = (*self.key, k, limit)
+        got = _FINE.get(key)
+        if got is None:
+            got = (np.zeros((self.ny * k, self.nx * k), dtype=bool),
+                   np.zeros((self.ny, self.nx), dtype=bool))
+            _remember(_FINE, key, got)
+        base, done = got
+        hf = self.h / k
+        todo = near & ~done
+        if todo.any():
+            fi, fj = _fine_cells(todo, k)
+            pts = np.column_stack([self.x0 + (fj + 0.5) * hf, self.y0 + (fi + 0.5) * hf])
+            base[fi, fj] = self.base.points_clear(pts, limit)
+            done |= todo
+        fi, fj = _fine_cells(near, k)
+        vals = base[fi, fj]
+        at = np.flatnonzero(vals)
+        pts = np.column_stack([self.x0 + (fj[at] + 0.5) * hf, self.y0 + (fi[at] + 0.5) * hf])
+        vals[at] = self._clear_of_shapes(pts, limit)
+        fine[fi, fj] = vals
 
 
 def _centres(x0: float, y0: float, h: float, nx: int, ny: int) -> np.ndarray:
