@@ -17,7 +17,7 @@ import numpy as np
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.trajectory import _path
 
-__all__ = ["clean_path", "remaining_path", "shortcut_path"]
+__all__ = ["clean_path", "polyline_length", "remaining_path", "shortcut_path"]
 
 
 def clean_path(path: np.ndarray, tol: float = 1e-9, collinear_tol: float = 1e-9) -> np.ndarray:
@@ -39,6 +39,17 @@ def clean_path(path: np.ndarray, tol: float = 1e-9, collinear_tol: float = 1e-9)
     # replaces the last kept one), then interior points off the chord of their kept predecessor
     # and next point by less than collinear_tol and strictly between them.
     return _path.clean_points(p, float(tol), float(collinear_tol))
+
+
+def polyline_length(path: np.ndarray) -> float:
+    """Length [m] of the polyline through ``path`` (N, 2) [m] (0 for fewer than two points).
+
+    Examples:
+        >>> polyline_length(np.array([[0.0, 0.0], [3.0, 4.0], [3.0, 5.0]]))
+        6.0
+    """
+    p = np.asarray(path, dtype=float).reshape(-1, 2)
+    return float(np.sum(np.hypot(*np.diff(p, axis=0).T))) if len(p) >= 2 else 0.0
 
 
 def shortcut_path(path: np.ndarray, obstacles: ObstacleSet, radius: float) -> np.ndarray:
