@@ -196,43 +196,6 @@ def test_prove_blocked_ends_a_detour_search_that_cannot_succeed(gap):
         assert 3 < batches[True] <= 2 + 4 * 2 + 2 < 2 * 20 <= batches[False]
 
 
-def test_an_optional_search_ends_at_its_stop_time():
-    # The narrow gap of the test above (only the visibility graph proves it closed), on time
-    # budgets: a detour search whose stop time has passed ends after its probe (one search);
-    # without one it goes on (the probe, four more budgets, then the proof). Under
-    # batches_per_plan (deterministic) the stop time is ignored: work alone decides.
-    import time
-
-    from anyplan.planning.bitstar import BITStar
-    from anyplan.planning.problem import Problem
-
-    sc = load_scenario("paper-1")
-    spec = sc.robot
-    r = spec.radius + 0.03
-    lo, hi = 6.0 - (r - 0.005), 6.0 + (r - 0.005)
-    wall = [rectangle((10.0, lo / 2.0), (0.4, lo)), rectangle((10.0, (hi + 11.0) / 2.0),
-                                                              (0.4, 11.0 - hi))]
-    obst = sc.obstacle_set().with_shapes(wall)
-    problem = Problem.create(obst, spec.start[:2], spec.goal, r)
-
-    def searches(cfg, stop_at):
-        loop = SequentialBITStar(obst, robot_radius=spec.radius, plan_radius=r, config=cfg,
-                                 rng=np.random.default_rng(0))
-        planner = BITStar(problem, cfg.bitstar, rng=loop.rng)
-        calls = []
-        solve = planner.solve
-        planner.solve = lambda cond: (calls.append(cond), solve(cond))[1]
-        loop._solve(planner, False, stop_at)
-        assert not planner.result().solved
-        return len(calls), planner.n_batches
-
-    timed_cfg = SequentialConfig(prove_blocked=True)
-    assert searches(timed_cfg, time.perf_counter() - 1.0)[0] == 1
-    assert searches(timed_cfg, None)[0] == 2
-    work = SequentialConfig(batches_per_plan=2, prove_blocked=True)
-    assert searches(work, time.perf_counter() - 1.0) == searches(work, None)
-
-
 def test_a_motion_the_model_verified_is_not_checked_again(monkeypatch):
     # The loop takes a motion its model reports as verified without its own check; any
     # other motion is checked as before (and a predicted collision places a square).

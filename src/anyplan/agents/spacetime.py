@@ -87,9 +87,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             on with the detours where the budget cut the search; a motion arriving a lattice
             step earlier replaces it. At most this many calls per motion taken (0: never).
         improve_budget_s: ``search_budget_s`` of an improvement call [s] (the robot has a
-            safe motion already: about one path per call), which also stops its BIT* searches
-            once they have had their ordinary budget (a detour search around walkers in an
-            office ran 40 ms past it). None: no budget.
+            safe motion already: about one path per call; None: no budget).
         lattice_dt_s: Approximate step [s] of the velocity lattice.
         horizon_s: Horizon [s] of a prediction extrapolated from the current twist (perception
             ``twist`` or ``tracked``: no announced motion), at least the robot's
@@ -382,9 +380,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
                                                   first_wait_s=self.max_wait_s if long_bound
                                                   else None),
                                    chain=self._chain if inc is not None else (),
-                                   verified=self._is_candidate,
-                                   # improving is optional: its searches end on its budget
-                                   stop_at=self._search_deadline if inc is not None else None)
+                                   verified=self._is_candidate)
         self._chain = list(res.virtual_obstacles) if self._cut else []
         if not self._cands and self._tried and long_ok:
             # No timing at all: allow long waits on the shortest path (unless the loop gave it

@@ -251,22 +251,13 @@ class SequentialBITStar:
         # At least a first solution: keep searching (up to 20 budgets) until one exists.
         return any_of(timed(budget) & first_solution(), timed(20.0 * budget))
 
-    def _solve(self, planner: BITStar, first: bool, stop_at: float | None = None) -> None:
+    def _solve(self, planner: BITStar, first: bool) -> None:
         """One BIT* search on its budget; with ``prove_blocked``, a detour search first gets
         only its ordinary budget and goes on only if start and goal may still be connected
-        (the same stopping points as :meth:`_budget` otherwise). With ``stop_at`` (a
-        ``time.perf_counter`` time), a search that has used its ordinary budget also stops
-        then (see :meth:`replan`)."""
+        (the same stopping points as :meth:`_budget` otherwise)."""
         cfg = self.config
-        if cfg.batches_per_plan is not None:
-            stop_at = None  # work, not time, decides (deterministic)
         if first or not cfg.prove_blocked:
-            budget = self._budget(first)
-            if stop_at is not None:
-                # at least the ordinary budget, then no later than stop_at
-                least = cfg.first_budget_s if first else cfg.iteration_budget_s
-                budget = any_of(budget, timed(max(stop_at - time.perf_counter(), least)))
-            planner.solve(budget)
+            planner.solve(self._budget(first))
             return
         # the probe, the cell cover's proof, four more budgets, the visibility graph's proof
         # (among few obstacles; it also proves passages closed by less than a cell, but costs
@@ -285,11 +276,6 @@ class SequentialBITStar:
         p = planner.problem
         if provably_disconnected(p.obstacles, p.start, p.goal, p.radius):
             return
-        if stop_at is not None:
-            left = stop_at - time.perf_counter()
-            if left > 0.0:
-                planner.solve(any_of(more, timed(left)))
-            return
         planner.solve(more)
         if planner.result().solved or exactly_unsolvable(p):
             return
@@ -298,8 +284,7 @@ class SequentialBITStar:
     def replan(self, start: np.ndarray, goal: np.ndarray, predictions: Sequence[PredictedObstacle],
                t_now: float, motion: MotionModel | None = None,
                chain: Sequence[VirtualObstacle] = (),
-               verified: Callable[[TimedMotion], bool] | None = None,
-               stop_at: float | None = None) -> SequentialResult:
+               verified: Callable[[TimedMotion], bool] | None = None) -> SequentialResult:
         """Plan from ``start`` to ``goal`` until the predicted motion is collision-free.
 
         Args:
@@ -313,11 +298,6 @@ class SequentialBITStar:
                 is no longer clear of them.
             verified: True for a motion of ``motion`` that the model itself has checked free
                 of the predictions: the loop takes it without checking it again.
-            stop_at: For an optional search (the caller has a motion already, e.g. an
-                improvement): a ``time.perf_counter`` time after which each BIT* search stops
-                once it has had its ordinary budget (a detour search's probe); the loop ends
-                where a search stops without a path. None (default): the budgets alone, and
-                ignored under ``batches_per_plan`` (work decides).
         """
         motion_fn = motion or self.motion
         if motion_fn is None:
@@ -354,7 +334,7 @@ class SequentialBITStar:
                                   rng=self.rng)
             # the first plan's budget for the plan among the static obstacles only (a chain
             # taken up starts with a detour search)
-            self._solve(planner, not squares, stop_at)
+            self._solve(planner, not squares)
             res = planner.result()
             plan_time += time.perf_counter() - t0
             if not res.solved:
