@@ -35,6 +35,7 @@ from anyplan.experiments.dbfile import (
     connect_readonly,
 )
 from anyplan.simulation.result import RunResult, RunStatus
+from anyplan.trajectory.path import polyline_length
 
 __all__ = [
     "ResultsDB",
@@ -148,7 +149,7 @@ def _polyline_length(path: Any) -> float | None:
     p = np.asarray(path, dtype=float)
     if p.ndim != 2 or p.shape[0] < 2 or p.shape[1] < 2:
         return None
-    return float(np.hypot(*np.diff(p[:, :2], axis=0).T).sum())
+    return polyline_length(p[:, :2])
 
 
 def progress_rows(result: Mapping[str, Any]) -> list[tuple[float, float, int | None, str]]:

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from anyplan.experiments.generate import P3DX, GenerationError
+from anyplan.trajectory.path import polyline_length
 from anyplan.world.scenario import Scenario, scenario_from_dict
 
 __all__ = ["ROOM", "WALL_X", "gap_scenario", "gap_world", "gap_suite", "issue_gap_scenario",
@@ -118,7 +119,7 @@ def waiting_is_safe(scenario: Scenario, y_gap: float, step: float = 0.05) -> boo
         near = _route_distance(p, route) < r.radius + o.radius + 0.3 + slack
         if near.any():
             clear_from = max(clear_from, float(t[np.flatnonzero(near)[-1]]) + step)
-    length = float(np.sum(np.hypot(*np.diff(route, axis=0).T)))
+    length = polyline_length(route)
     return clear_from + length / r.v_max + 10.0 <= scenario.time_limit
 
 

@@ -436,6 +436,9 @@ class _Stack:
         line: x0 [m], y0 [m], theta0 [rad], v [m/s], start_time [s] of those, one array each.
         taus: the growth knots [s] shared by every growing one among them (None when they
             differ: each is then interpolated on its own).
+        t0: (n,) each growth's t0 [s] (nan without growth).
+        values: (n, K) each growth's values [m] on ``taus`` (when shared; else K = 0).
+        growths: each obstacle's growth (None without), for the interpolation one by one.
     """
 
     boxes: np.ndarray
@@ -446,8 +449,8 @@ class _Stack:
     straight: np.ndarray
     line: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
     taus: np.ndarray | None
-    t0: np.ndarray  # (n,) each growth's t0 [s] (nan without growth)
-    values: np.ndarray  # (n, K) each growth's values on ``taus`` [m] (when shared)
+    t0: np.ndarray
+    values: np.ndarray
     growths: tuple[RadiusGrowth | None, ...]
 
 
