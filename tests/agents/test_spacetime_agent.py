@@ -739,3 +739,39 @@ def test_a_safety_decision_ready_after_its_switch_time_is_made_from_the_later_st
         assert t_sw - decided[id(tr)] >= slow - 1e-9  # not before the guard could decide it
         assert float(tr.t_start) == pytest.approx(t_sw)  # from the state at its switch
     assert r.extra["late_plans"] >= len(taken)
+
+
+def test_the_motion_is_checked_every_twist_check_period_among_exact_twists(monkeypatch):
+    # With exact twists (no announced motion, no uncertain disc) each check is the robot's
+    # next chance to react to a changed prediction: every twist_check_period_s (0.1 s); with
+    # announced motions, tracked obstacles, and with the option off, every check_period_s
+    # (0.2 s) as before.
+    from anyplan.agents.spacetime import SpaceTimeBITStarAgent
+    from anyplan.simulation.perception import override_sensing
+
+    times: list[float] = []
+    original = SpaceTimeBITStarAgent._check
+
+    def spy(self, obs, preds):
+        times.append(obs.t)
+        return original(self, obs, preds)
+
+    monkeypatch.setattr(SpaceTimeBITStarAgent, "_check", spy)
+    base = scenario_from_dict(head_on_corridor_dict(2.0))
+
+    def usual_interval(sc, **options):
+        times.clear()
+        simulate(sc, make_agent("st-bitstar", planning_delay=0.1, **options), seed=0)
+        gaps, counts = np.unique(np.round(np.diff(times), 6), return_counts=True)
+        assert len(times) > 5
+        return float(gaps[np.argmax(counts)])
+
+    assert usual_interval(override_sensing(base, "twist")) == pytest.approx(0.1)
+    assert usual_interval(override_sensing(base, "twist"),
+                          twist_check_period_s=0.15) == pytest.approx(0.15)
+    for sc, options in ((base, {}), (override_sensing(base, "tracked"), {}),
+                        (override_sensing(base, "twist"), {"twist_check_period_s": None})):
+        assert usual_interval(sc, **options) == pytest.approx(0.2)
+    for bad in (0.0, -0.1, "often"):
+        with pytest.raises(ValueError, match="twist_check_period_s"):
+            make_agent("st-bitstar", twist_check_period_s=bad)

@@ -215,6 +215,7 @@ class ReplanningAgent(Agent):
         self._last_t = obs.t
         t = obs.t
         preds = self.predictor.predict(obs.obstacles)
+        self._note_predictions(preds)
         if self.pending is not None and t >= self.pending[0] - 1e-9:
             self._switch()
         if self.trajectory is None and self.pending is None:
@@ -227,7 +228,7 @@ class ReplanningAgent(Agent):
             if self.pending is not None and t >= self.pending[0] - 1e-9:
                 self._switch()
         elif (self.trajectory is not None and self.pending is None
-              and (t - self._last_check >= self.check_period_s - 1e-9
+              and (t - self._last_check >= self._period() - 1e-9
                    or self._requested is not None)):
             self._check(obs, preds)
         traj = self.trajectory
@@ -262,6 +263,13 @@ class ReplanningAgent(Agent):
                                                   obs.robot.y - spec.goal[1]) <= spec.goal_tolerance
 
     # --- what subclasses provide -----------------------------------------------------------------
+    def _note_predictions(self, preds: list[PredictedObstacle]) -> None:
+        """Called with each step's predictions before anything is decided (nothing here)."""
+
+    def _period(self) -> float:
+        """The period [s] of the checks of the motion in use: ``check_period_s``."""
+        return self.check_period_s
+
     def _replan(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
         raise NotImplementedError
 

@@ -28,7 +28,7 @@ __all__ = ["SafetyDecisions"]
 
 class SafetyDecisions:
     """The safety decisions of an ``st-bitstar`` agent (a mixin: it reads the agent's ``spec``,
-    ``obstacles``, ``guard``, ``reference``, ``check_period_s``, ``trajectory``, ``record``,
+    ``obstacles``, ``guard``, ``reference``, ``_period``, ``trajectory``, ``record``,
     ``passive_safety``, ``reach_extra_mps``, ``reach_min_speed_mps``, ``_capped`` and
     ``_state_at``)."""
 
@@ -37,13 +37,13 @@ class SafetyDecisions:
     guard: Any
     reference: Any
     record: Any
-    check_period_s: float
     trajectory: Trajectory | None
     passive_safety: bool
     reach_extra_mps: float
     reach_min_speed_mps: float
     _capped: Callable[[list[PredictedObstacle]], list[PredictedObstacle]]  # PlanningPredictions'
     _state_at: Callable[[Observation, float], RobotState]  # ReplanningAgent's
+    _period: Callable[[], float]  # the check period in force [s] (SpaceTimeBITStarAgent's)
 
     def _guard(self, obs: Observation, t_switch: float, motion: Trajectory | None,
                safe: list[PredictedObstacle], observed: list[PredictedObstacle],
@@ -55,7 +55,7 @@ class SafetyDecisions:
         ``passive_safety``, both must also be passively safe against the reachable discs of
         the ``observed`` predictions (:meth:`_reach`). Returns the decision's kind and
         trajectory."""
-        commit = self.check_period_s + max(t_switch - obs.t, 0.0)
+        commit = self._period() + max(t_switch - obs.t, 0.0)
         state = self._state_at(obs, t_switch)
         reach = self._reach(observed, t_switch, state)
         # the guard's own fallback is not asked for: _evasions ranks its candidates with more
@@ -106,7 +106,7 @@ class SafetyDecisions:
         return self._ranker().rank(tr, t, full, planned, reach)
 
     def _ranker(self) -> FallbackRanker:
-        return FallbackRanker(self.spec, self.obstacles, self.guard, self.check_period_s)
+        return FallbackRanker(self.spec, self.obstacles, self.guard, self._period())
 
     def _fallback(self, obs: Observation, t_switch: float, preds: list[PredictedObstacle],
                   reason: str) -> Trajectory | None:
