@@ -188,22 +188,18 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
                                              and plan_extra_m >= 0.0):
             raise ValueError(f"plan_extra_m: must be >= 0 or null, got {plan_extra_m!r}")
         self.plan_extra_m = None if plan_extra_m is None else float(plan_extra_m)
-        if twist_check_period_s is not None and not (
-                isinstance(twist_check_period_s, int | float) and twist_check_period_s > 0.0):
-            raise ValueError("twist_check_period_s: must be > 0 or null, got "
-                             f"{twist_check_period_s!r}")
-        self.twist_check_period_s = (None if twist_check_period_s is None
-                                       else float(twist_check_period_s))
-        self._exact_twists = False  # the latest obstacles observed: exact twists, no future
         if not (isinstance(accept_s, int | float) and 0.0 <= accept_s <= patience_s):
             raise ValueError(f"accept_s: must be in [0, patience_s], got {accept_s!r}")
         self.accept_s = float(accept_s)
         for name, limit in (("search_budget_s", search_budget_s),
-                            ("improve_budget_s", improve_budget_s)):
+                            ("improve_budget_s", improve_budget_s),
+                            ("twist_check_period_s", twist_check_period_s)):
             if limit is not None and not (isinstance(limit, int | float) and limit > 0.0):
                 raise ValueError(f"{name}: must be > 0 or null, got {limit!r}")
         self.search_budget_s = None if search_budget_s is None else float(search_budget_s)
         self.improve_budget_s = None if improve_budget_s is None else float(improve_budget_s)
+        self.twist_check_period_s = (None if twist_check_period_s is None
+                                     else float(twist_check_period_s))
         self._search_deadline: float | None = None
         self._last_build: float | None = None  # wall clock [s] of the last path built
         if not (isinstance(improve_calls, int) and improve_calls >= 0):
@@ -232,6 +228,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         self._rows: RowCache | None = None
         #: Nominal motions of this replanning and whether each is free as timed (``_timed_fn``).
         self._nominals: dict[tuple[Any, ...], tuple[Trajectory, bool | None, list[Shape]]] = {}
+        #: whether the latest obstacles observed are predicted from exact twists (_period)
         self._exact_twists = False
 
     def _new_record(self) -> SpaceTimeStats:

@@ -120,7 +120,7 @@ def provably_disconnected(obstacles: ObstacleSet, start: np.ndarray | tuple[floa
     fine = np.repeat(np.repeat(open_, k, axis=0), k, axis=1)
     if cover is None:
         fi, fj = _fine_cells(near, k)
-        pts = np.column_stack([x0 + (fj + 0.5) * hf, y0 + (fi + 0.5) * hf])
+        pts = _fine_centres(x0, y0, hf, fi, fj)
         fine[fi, fj] = obstacles.points_clear(pts, fine_limit)
     else:
         cover.refine(fine, near, k, fine_limit)
@@ -135,6 +135,11 @@ def _fine_cells(near: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
     rows, cols = np.nonzero(near)
     di, dj = np.divmod(np.arange(k * k), k)
     return (rows[:, None] * k + di[None, :]).ravel(), (cols[:, None] * k + dj[None, :]).ravel()
+
+
+def _fine_centres(x0: float, y0: float, hf: float, fi: np.ndarray, fj: np.ndarray) -> np.ndarray:
+    """Centres (N, 2) [m] of the fine cells (rows ``fi``, columns ``fj``) of side ``hf``."""
+    return np.column_stack([x0 + (fj + 0.5) * hf, y0 + (fi + 0.5) * hf])
 
 
 #: Recent pass/fail masks of a map's boxes and walls (:class:`_Cover`), by cover and limit.
@@ -207,13 +212,13 @@ class _Cover:
         todo = near & ~done
         if todo.any():
             fi, fj = _fine_cells(todo, k)
-            pts = np.column_stack([self.x0 + (fj + 0.5) * hf, self.y0 + (fi + 0.5) * hf])
+            pts = _fine_centres(self.x0, self.y0, hf, fi, fj)
             base[fi, fj] = self.base.points_clear(pts, limit)
             done |= todo
         fi, fj = _fine_cells(near, k)
         vals = base[fi, fj]
         at = np.flatnonzero(vals)
-        pts = np.column_stack([self.x0 + (fj[at] + 0.5) * hf, self.y0 + (fi[at] + 0.5) * hf])
+        pts = _fine_centres(self.x0, self.y0, hf, fi[at], fj[at])
         vals[at] = self._clear_of_shapes(pts, limit)
         fine[fi, fj] = vals
 
