@@ -9,7 +9,8 @@ docs/perception.md), for every planner and peer on the same seeds:
   view on average, up to ~55), always ``tracked``;
 * ``gaps``: spacetime's gap worlds with detection noise (``tracked``);
 * ``prediction``: ADE/FDE on ETH/UCY (8 frames observed, 12 predicted, 2.5 Hz) of our tracker
-  against the constant-velocity baseline, and the coverage of the uncertainty radius.
+  against the constant-velocity baseline, and the coverage of the uncertainty radius; and the
+  tracker's predictions of the DynaBARN worlds' obstacles (``--worlds``) 0.5-3 s ahead.
 
 Per (suite, mode, planner): successes, collisions, robot-caused collisions, smallest distance to
 a moving obstacle, discomfort time, time / lower bound, planning time per call (median and 95th
@@ -21,16 +22,19 @@ Usage::
 
     python benchmarks/unknown.py [--only dynabarn,crowds,gaps,prediction] [--modes twist,tracked]
         [--planners st-bitstar,seq-bitstar,dovs,orca] [--worlds 20-59] [--windows 9] [--seeds 1]
-        [--jobs 2] [--set [PLANNER:]KEY=VALUE ...] [--deterministic]
+        [--jobs 2] [--set [PLANNER:]KEY=VALUE ...] [--deterministic] [--tracker KEY=VALUE ...]
 
 ``--set`` and ``--deterministic`` are ``anyplan bench``'s (agent settings; a fixed planning delay
 and budgets, so that a run depends only on its scenario, settings and seed, not on the load).
+``--tracker`` is ``anyplan run``'s: settings of the tracker and its uncertain discs for every
+``tracked`` run and for the prediction scores.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -44,16 +48,17 @@ if not SHARED.is_dir():
     SHARED = Path("/work/shared/benchmarks")
 
 
-def _run(task: tuple[str, dict[str, Any], str, str, int, dict[str, Any]]) -> dict[str, Any]:
+def _run(task: tuple[str, dict[str, Any], str, str, int, dict[str, Any],
+                     tuple[tuple[str, float], ...]]) -> dict[str, Any]:
     from anyplan.agents import make_agent
-    from anyplan.simulation import simulate
+    from anyplan.simulation import SimConfig, simulate
     from anyplan.simulation.perception import override_sensing
     from anyplan.world.scenario import scenario_from_dict
 
-    suite, data, planner, mode, seed, config = task
+    suite, data, planner, mode, seed, config, tracker = task
     sc = override_sensing(scenario_from_dict(data, f"<{data['name']}>"), mode)
     try:
-        res = simulate(sc, make_agent(planner, **config), seed=seed)
+        res = simulate(sc, make_agent(planner, **config), seed=seed, config=SimConfig(tracker=tracker))
     except Exception as exc:  # noqa: BLE001 - a planner failure is a result, reported
         return {"suite": suite, "mode": mode, "planner": planner, "scenario": sc.name, "seed": seed,
                 "status": f"error: {type(exc).__name__}", "times": []}
@@ -105,20 +110,70 @@ def _gaps(n: int) -> list[dict[str, Any]]:
     return [sc.to_dict() for sc in gap_suite(0, n)]
 
 
-def _prediction() -> str:
+def _prediction(tracker: tuple[tuple[str, float], ...] = ()) -> str:
     from anyplan.experiments.crowds import read_obsmat
     from anyplan.experiments.prediction_eval import evaluate_prediction, trajectory_samples
+    from anyplan.simulation.perception import tracking_configs
 
     lines = ["| scene | noise [m] | samples | ADE CV | FDE CV | ADE ours | FDE ours | coverage (all) "
              "| coverage <= 2 s | mean extra radius at 1.2 / 2.0 / 4.8 s [m] |", "|" + "---|" * 10]
     for f in ("eth_hotel", "ucy_zara01"):
         s = trajectory_samples(read_obsmat(SHARED / "crowds" / f"{f}_obsmat.txt"), stride=2)
         for noise in (0.0, 0.05):
-            r = evaluate_prediction(s, noise_m=noise, seed=0)
+            tc, um = tracking_configs({"sigma_m": max(noise, 0.02), **dict(tracker)}, noise)
+            r = evaluate_prediction(s, noise_m=noise, seed=0, tracker=tc, uncertainty=um)
             c, e = np.array(r.coverage_by_horizon), np.array(r.mean_extra_by_horizon)
             lines.append(f"| {f} | {noise:g} | {r.samples} | {r.ade_cv:.3f} | {r.fde_cv:.3f} | "
                          f"{r.ade_imm:.3f} | {r.fde_imm:.3f} | {r.coverage:.3f} | {c[:5].mean():.3f} | "
                          f"{e[2]:.2f} / {e[4]:.2f} / {e[11]:.2f} |")
+    return "\n".join(lines)
+
+
+def _prediction_dynabarn(worlds: list[int], tracker: tuple[tuple[str, float], ...] = ()) -> str:
+    """The tracker's predictions of DynaBARN's obstacles (every obstacle of ``worlds`` detected
+    at 10 Hz with 5 cm noise for 30 s, seed 0; predicted every 0.2 s from 1 s on): the error of
+    the predicted centre and the disc's extra radius at 0.5, 1, 2 and 3 s ahead, the share of
+    true centres inside the disc, and the speed error of the estimate. The obstacles run
+    straight between corners where they turn or reverse: the mean error is the corners'."""
+    from anyplan.prediction.base import ConstantTwistPredictor
+    from anyplan.prediction.detection import Detection
+    from anyplan.prediction.tracking import Tracker
+    from anyplan.simulation.perception import tracking_configs
+    from anyplan.world.scenario import scenario_from_dict
+
+    tc, um = tracking_configs(dict(tracker), 0.05)
+    pred = ConstantTwistPredictor(use_announced=False)
+    rng = np.random.default_rng(0)
+    ahead = np.array([0.5, 1.0, 2.0, 3.0])
+    err, extra, speed = [], [], []
+    for d in _dynabarn(worlds):
+        sc = scenario_from_dict(d, f"<{d['name']}>")
+        movers = {o.name: o for o in sc.moving_obstacles}
+        tr = Tracker(tc)
+        for k in range(301):
+            t = 0.1 * k
+            z = [(o, np.asarray(o.position(t)) + rng.normal(0.0, 0.05, 2)) for o in movers.values()]
+            tr.update(t, [Detection(o.name, t, float(p[0]), float(p[1]), o.radius) for o, p in z])
+            if k < 10 or k % 2:
+                continue
+            obs = um.observations(tr.estimates(t))
+            for ob, pr in zip(obs, pred.predict(obs), strict=True):
+                o = movers[ob.name]
+                truth = np.array([o.position(t + h) for h in ahead])
+                err.append(np.hypot(*(pr.positions(t + ahead) - truth).T))
+                extra.append(pr.growth.at(t + ahead) if pr.growth is not None else 0.0 * ahead)
+                vel = (np.asarray(o.position(t + 0.01)) - np.asarray(o.position(t - 0.01))) / 0.02
+                speed.append(math.hypot(ob.v * math.cos(ob.theta) - vel[0],
+                                        ob.v * math.sin(ob.theta) - vel[1]))
+    e, x, v = np.array(err), np.array(extra), np.array(speed)
+    lines = ["| ahead [s] | " + " | ".join(f"{h:g}" for h in ahead) + " |", "|---|" + "---|" * 4]
+    lines.append("| centre error, mean [m] | " + " | ".join(f"{a:.2f}" for a in e.mean(0)) + " |")
+    lines.append("| centre error, median [m] | " + " | ".join(f"{a:.2f}" for a in np.median(e, 0))
+                 + " |")
+    lines.append("| extra radius, mean [m] | " + " | ".join(f"{a:.2f}" for a in x.mean(0)) + " |")
+    lines.append("| inside the disc | " + " | ".join(f"{a:.3f}" for a in (e <= x).mean(0)) + " |")
+    lines += ["", f"{len(v)} predictions; speed error of the estimate: median {np.median(v):.3f} "
+              f"m/s, mean {v.mean():.3f} m/s, 90th percentile {np.percentile(v, 90):.3f} m/s."]
     return "\n".join(lines)
 
 
@@ -162,9 +217,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--rows", default=None, help="also write every run's row as JSON here")
     from anyplan.agents.settings import SettingsError
     from anyplan.cli.agent_options import add_agent_options, bench_configs
+    from anyplan.cli.perception_opts import add_tracker_option, tracker_settings
+    from anyplan.errors import UsageError
 
     add_agent_options(ap, bench=True)  # --set [PLANNER:]KEY=VALUE, --deterministic (as anyplan bench)
+    add_tracker_option(ap)  # --tracker KEY=VALUE (as anyplan run)
     a = ap.parse_args(argv)
+    try:
+        tracker = tracker_settings("unknown.py", a)
+    except UsageError as exc:  # one line, exit 2
+        ap.error(str(exc))
     from anyplan.agents.base import AGENTS
     from anyplan.experiments.dynabarn import parse_worlds
 
@@ -187,20 +249,22 @@ def main(argv: list[str] | None = None) -> int:
               "", "Command: `python benchmarks/unknown.py " + " ".join(sys.argv[1:] if argv is None
                                                                      else argv) + "`", ""]
     if "prediction" in only:
-        report += ["## Prediction on ETH/UCY", "", _prediction(), ""]
+        report += ["## Prediction on ETH/UCY", "", _prediction(tracker), "",
+                   "## Prediction of DynaBARN's obstacles (5 cm, 10 Hz)", "",
+                   _prediction_dynabarn(parse_worlds(a.worlds), tracker), ""]
         print("\n".join(report), flush=True)
     tasks = []
     seeds = range(a.first_seed, a.first_seed + a.seeds)
     if "dynabarn" in only:
         for d in _dynabarn(parse_worlds(a.worlds)):
-            tasks += [("dynabarn", d, p, m, s, configs[p]) for m in modes for p in planners
+            tasks += [("dynabarn", d, p, m, s, configs[p], tracker) for m in modes for p in planners
                       for s in seeds]
     if "crowds" in only:
         for tag, d in _crowds(a.windows):
-            tasks += [(tag, d, p, "tracked", s, configs[p]) for p in planners for s in seeds]
+            tasks += [(tag, d, p, "tracked", s, configs[p], tracker) for p in planners for s in seeds]
     if "gaps" in only:
         for d in _gaps(a.gaps):
-            tasks += [("gaps", d, p, "tracked", s, configs[p]) for p in planners for s in seeds]
+            tasks += [("gaps", d, p, "tracked", s, configs[p], tracker) for p in planners for s in seeds]
     rows = []
     t0 = time.perf_counter()
     if tasks:

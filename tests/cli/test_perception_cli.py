@@ -33,3 +33,30 @@ def test_run_records_the_perception_mode(tmp_path):
     p = json.loads((out / "result.json").read_text())["extra"]["perception"]
     assert p["mode"] == "tracked" and p["noise_m"] == 0.2 and p["rate_hz"] == 5.0
     assert p["frames"] == 15 and p["noise_seed"][0] == 0
+
+
+@pytest.mark.parametrize(("item", "words"), [
+    ("q_c=0.01", "--tracker: unknown tracker setting 'q_c'; did you mean 'q_cv'?"),
+    ("q_cv=-1", "--tracker: TrackerConfig.q_cv: must be > 0"),
+    ("turn_confidence=2", "--tracker: UncertaintyModel.turn_confidence: must be in [0, 1]"),
+    ("k_sigma=two", "--tracker: k_sigma: expected a number, got 'two'"),
+    ("k_sigma", "--tracker: expected KEY=VALUE, got 'k_sigma'"),
+])
+def test_bad_tracker_settings_exit_2_with_one_line(tmp_path, capsys, item, words):
+    argv = ["run", "paper-1", "--planner", "straight", "--out", str(tmp_path / "r"),
+            "--perception", "tracked", "--tracker", item]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err
+    assert not (tmp_path / "r").exists()  # refused before any work
+
+
+def test_run_records_the_tracker_settings_it_used(tmp_path):
+    out = tmp_path / "r"
+    assert main(["run", "paper-1", "--planner", "straight", "--out", str(out), "--no-plot",
+                 "--perception", "tracked", "--sensor-noise", "0.2", "--time-limit", "1",
+                 "--tracker", "q_cv=0.01", "--tracker", "k_sigma=1.5"]) == 1
+    t = json.loads((out / "result.json").read_text())["extra"]["perception"]["tracker"]
+    # the given ones, the sensor's noise as the tracker's, the defaults elsewhere
+    assert t["q_cv"] == 0.01 and t["k_sigma"] == 1.5 and t["sigma_m"] == 0.2
+    assert t["q_ct"] == 0.05 and t["cap_m"] == 1.0

@@ -231,3 +231,53 @@ def test_bad_sensing_block_names_the_field(block, field):
     with pytest.raises(ScenarioError) as ei:
         scenario_from_dict(d, "f.yaml")
     assert ei.value.field == field and "f.yaml" in str(ei.value)
+
+
+
+class Estimates(Recorder):
+    """Records the tracker's estimates (behind the tracking front end)."""
+
+    name = "estimates"
+    handles_detections = False
+
+
+def test_tracking_settings_reach_the_tracker_and_its_discs():
+    from anyplan.agents.perceiving import TrackingAgent
+    from anyplan.simulation.perception import tracking_configs, with_tracking
+
+    spec = SensingSpec("tracked", 0.07, 10.0)
+    ag = with_tracking(Estimates(), spec, {"q_cv": 0.01, "cap_m": 0.5})
+    assert isinstance(ag, TrackingAgent)
+    assert ag.tracker_config.q_cv == 0.01 and ag.tracker_config.sigma_m == 0.07
+    assert ag.uncertainty.cap_m == 0.5 and ag.uncertainty.k_sigma == 2.0
+    # a robot that does not know its sensor's noise may say so
+    assert tracking_configs({"sigma_m": 0.1}, 0.07)[0].sigma_m == 0.1
+    # other modes are not tracked, whatever the settings
+    assert not isinstance(with_tracking(Estimates(), SensingSpec("twist"), {"q_cv": 0.01}),
+                          TrackingAgent)
+
+
+def test_tracker_settings_change_the_estimates_and_repeat():
+    sc = _tracked(static_obstacles=[])
+
+    def run(settings):
+        ag = Estimates()
+        res = simulate(sc, ag, seed=3,
+                       config=SimConfig(time_limit=2.0, tracker=tuple(sorted(settings.items()))))
+        return [(o.x, o.y, o.v) for ob in ag.log for o in ob.obstacles], res
+
+    quiet, res = run({"q_cv": 0.001, "q_ct": 0.001})
+    assert len(quiet) >= 15  # an estimate at every step after the first frame
+    assert quiet == run({"q_cv": 0.001, "q_ct": 0.001})[0]  # seeded: the same estimates
+    assert quiet != run({})[0]  # the process noise is the tracker's
+    assert res.extra["perception"]["tracker"]["q_cv"] == 0.001
+    assert res.extra["perception"]["tracker"]["sigma_m"] == sc.sensing.noise_m
+
+
+def test_a_bad_tracker_setting_names_the_field():
+    from anyplan.config import SettingError
+
+    with pytest.raises(SettingError, match=r"SimConfig\.tracker: unknown tracker setting 'ksigma'"):
+        SimConfig(tracker=(("ksigma", 1.0),))
+    with pytest.raises(SettingError, match=r"UncertaintyModel\.cap_m: must be >= 0"):
+        SimConfig(tracker=(("cap_m", -1.0),))

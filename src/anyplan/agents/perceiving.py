@@ -18,6 +18,7 @@ wrapper asks the inner agent to replan (``request_replan(reason)``, if it has on
 from __future__ import annotations
 
 import math
+from dataclasses import fields
 
 import numpy as np
 
@@ -70,6 +71,15 @@ class TrackingAgent(Agent):
         self._plans = 0
         self.tube_exits = 0
         self._predictor = ConstantTwistPredictor(use_announced=False)
+
+    def settings(self) -> dict[str, float]:
+        """The tracker's settings and the uncertainty model's scalar ones, by name (what a
+        run records to be reproduced)."""
+        out = {f.name: float(getattr(self.tracker_config, f.name))
+               for f in fields(self.tracker_config)}
+        out.update({f.name: float(getattr(self.uncertainty, f.name))
+                    for f in fields(self.uncertainty) if f.name != "taus"})
+        return out
 
     def _check_tube(self, obs: Observation) -> str | None:
         k = 3.0 * max(self.tracker_config.sigma_m, 1e-3)

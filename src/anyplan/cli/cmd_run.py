@@ -11,7 +11,12 @@ from anyplan.agents.base import AGENTS, make_agent
 from anyplan.agents.stats import improvement_calls
 from anyplan.cli import checks
 from anyplan.cli.agent_options import add_agent_options, run_config
-from anyplan.cli.perception_opts import add_perception_options, apply_perception
+from anyplan.cli.perception_opts import (
+    add_perception_options,
+    add_tracker_option,
+    apply_perception,
+    tracker_settings,
+)
 from anyplan.errors import UsageError
 from anyplan.simulation.simulator import SimConfig, simulate
 from anyplan.world.scenario import builtin_scenarios, load_scenario
@@ -48,6 +53,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--speed", type=checks.playback_speed, default=4.0,
                    help="animation playback speed, x real time (default 4)")
     add_perception_options(p)
+    add_tracker_option(p)
     p.add_argument("--mcap", default=None, metavar="FILE",
                    help="also write the run as an MCAP file with ROS 2 messages (poses, plans, "
                         "obstacles; for Foxglove, RViz, ros2 bag); needs the 'mcap' extra")
@@ -109,8 +115,9 @@ def _compiling_notice() -> None:
 def _run(args: argparse.Namespace) -> int:
     scenario = apply_perception("run", [load_scenario(args.scenario)], args)[0]
     config = run_config(args, args.planner)  # unknown names and bad settings fail before any work
+    tracker = tracker_settings("run", args)
     try:
-        cfg = SimConfig(dt=args.dt, time_limit=args.time_limit)
+        cfg = SimConfig(dt=args.dt, time_limit=args.time_limit, tracker=tracker)
         cfg.steps(scenario.time_limit)
     except ValueError as exc:
         raise UsageError(f"run: {checks.flag_message(exc, checks.SIM_FLAGS)}") from None

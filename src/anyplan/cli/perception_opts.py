@@ -9,7 +9,7 @@ from anyplan.errors import UsageError
 from anyplan.world.scenario import Scenario
 from anyplan.world.sensing import DEFAULT_NOISE_M, DEFAULT_RATE_HZ, MODES
 
-__all__ = ["add_perception_options", "apply_perception"]
+__all__ = ["add_perception_options", "apply_perception", "add_tracker_option", "tracker_settings"]
 
 #: :class:`~anyplan.world.sensing.SensingSpec` fields -> the flags that set them.
 _FLAGS = {"mode": "--perception", "noise_m": "--sensor-noise", "rate_hz": "--sensor-rate"}
@@ -43,3 +43,25 @@ def apply_perception(command: str, scenarios: Sequence[Scenario],
     except ValueError as exc:  # a SensingError names its field; the flag is told here
         opt = _FLAGS.get(getattr(exc, "field", ""), "--perception")
         raise UsageError(f"{command}: {opt}: {exc}") from None
+
+
+def add_tracker_option(p: argparse.ArgumentParser) -> None:
+    """Add ``--tracker KEY=VALUE`` (repeatable) to ``p``."""
+    p.add_argument("--tracker", action="append", default=[], metavar="KEY=VALUE",
+                   help="tracked: a setting of the robot's tracker or of its uncertain discs, "
+                        "e.g. q_cv=0.01 or k_sigma=2 (repeatable; names and defaults in "
+                        "docs/perception.md, 'Tracker settings')")
+
+
+def tracker_settings(command: str, args: argparse.Namespace) -> tuple[tuple[str, float], ...]:
+    """The ``--tracker`` settings as ``(name, value)`` pairs.
+
+    Raises:
+        UsageError: a malformed item, an unknown name or a value out of range (exit code 2).
+    """
+    from anyplan.simulation.perception import parse_tracking_settings
+
+    try:
+        return parse_tracking_settings(args.tracker)
+    except ValueError as exc:
+        raise UsageError(f"{command}: --tracker: {exc}") from None

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from anyplan.config import setting, validate
 from anyplan.prediction.base import ObstacleObservation, RadiusGrowth
 from anyplan.prediction.tracking import TrackEstimate, ct_transition
 
@@ -35,13 +36,21 @@ class UncertaintyModel:
         accel_allowance: Manoeuvre allowance a_m [m/s^2].
         cap_m: Largest extra radius [m].
         taus: Horizon knots [s] (increasing, from 0; the last is the horizon cap).
+        turn_confidence: The track's turn rate is predicted only when its CT model's probability
+            is at least this; below it the track is predicted straight.
+
+    Invalid values raise :class:`~anyplan.config.SettingError` naming the field.
     """
 
-    k_sigma: float = 2.0
-    accel_allowance: float = 0.1
-    cap_m: float = 1.0
+    k_sigma: float = setting(2.0, lo=0.0, unit="", doc="standard deviations of position covered")
+    accel_allowance: float = setting(0.1, lo=0.0, unit="m/s^2", doc="manoeuvre allowance")
+    cap_m: float = setting(1.0, lo=0.0, unit="m", doc="largest extra radius")
     taus: tuple[float, ...] = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0)
-    turn_confidence: float = 0.7
+    turn_confidence: float = setting(0.7, lo=0.0, hi=1.0, unit="",
+                                     doc="P(CT) from which the turn rate is predicted")
+
+    def __post_init__(self) -> None:
+        validate(self)
 
     def _means(self, estimates: Sequence[TrackEstimate]) -> np.ndarray:
         """Mean states (N, 5), the turn rate kept only when P(CT) >= turn_confidence."""

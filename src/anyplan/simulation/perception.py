@@ -14,20 +14,24 @@ sees".
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from collections.abc import Mapping, Sequence
+from dataclasses import fields, replace
 
 import numpy as np
 
 from anyplan.agents.base import Agent
+from anyplan.errors import UnknownNameError
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.prediction.detection import Detection
+from anyplan.prediction.tracking import TrackerConfig
+from anyplan.prediction.uncertain import UncertaintyModel
 from anyplan.world.robot import RobotState
 from anyplan.world.scenario import Scenario
 from anyplan.world.sensing import SensingSpec
 
 __all__ = ["NOISE_STREAM", "Sensor", "observe_exact", "effective_sensing", "override_sensing",
-           "with_tracking"]
+           "with_tracking", "tracking_setting_names", "tracking_configs", "parse_tracking_settings"]
 
 #: Second entry of the noise generator's seed sequence ``(run seed, NOISE_STREAM)``.
 NOISE_STREAM = 0x5E45
@@ -139,14 +143,74 @@ def override_sensing(scenario: Scenario, mode: str | None = None, noise_m: float
     return replace(scenario, sensing=spec)
 
 
-def with_tracking(agent: Agent, spec: SensingSpec) -> Agent:
+def tracking_setting_names() -> tuple[str, ...]:
+    """The names a tracking setting may have: the fields of
+    :class:`~anyplan.prediction.tracking.TrackerConfig` (the tracker) and the scalar fields of
+    :class:`~anyplan.prediction.uncertain.UncertaintyModel` (the growing disc)."""
+    return tuple(f.name for f in fields(TrackerConfig)) + _UNCERTAINTY_FIELDS
+
+
+_UNCERTAINTY_FIELDS = ("k_sigma", "accel_allowance", "cap_m", "turn_confidence")
+
+
+def tracking_configs(settings: Mapping[str, float], noise_m: float
+                     ) -> tuple[TrackerConfig, UncertaintyModel]:
+    """The tracker's settings and its uncertainty model from ``settings`` (name -> value; see
+    :func:`tracking_setting_names`), the defaults elsewhere; the tracker's measurement noise
+    ``sigma_m`` is the sensor's ``noise_m`` [m] unless ``settings`` gives it (a robot may not
+    know its sensor's noise exactly).
+
+    Raises:
+        UnknownNameError: a name that is neither (with the nearest known one).
+        SettingError: a value out of its field's range (naming the field).
+    """
+    known = tracking_setting_names()
+    for name in settings:
+        if name not in known:
+            raise UnknownNameError("tracker setting", name, list(known))
+    tracker = {k: float(v) for k, v in settings.items() if k not in _UNCERTAINTY_FIELDS}
+    tracker.setdefault("sigma_m", float(noise_m))
+    disc = {k: float(v) for k, v in settings.items() if k in _UNCERTAINTY_FIELDS}
+    return TrackerConfig(**tracker), UncertaintyModel(**disc)  # type: ignore[arg-type]
+
+
+def parse_tracking_settings(items: Sequence[str]) -> tuple[tuple[str, float], ...]:
+    """``KEY=VALUE`` strings (``--tracker``) as sorted ``(name, value)`` pairs, checked by
+    :func:`tracking_configs`.
+
+    Raises:
+        ValueError: an item without ``=`` or with a value that is not a finite number, an unknown
+            name or a value out of range; the message is one line naming the setting.
+    """
+    out: dict[str, float] = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ValueError(f"expected KEY=VALUE, got '{item}'")
+        try:
+            value = float(text)
+        except ValueError:
+            raise ValueError(f"{key}: expected a number, got '{text}'") from None
+        if not math.isfinite(value):
+            raise ValueError(f"{key}: expected a finite number, got '{text}'")
+        out[key] = value
+    try:
+        tracking_configs(out, 0.05)
+    except UnknownNameError as exc:
+        raise ValueError(str(exc)) from None
+    return tuple(sorted(out.items()))
+
+
+def with_tracking(agent: Agent, spec: SensingSpec,
+                  settings: Mapping[str, float] | None = None) -> Agent:
     """``agent`` behind the tracking front end (:class:`~anyplan.agents.perceiving.TrackingAgent`,
-    its tracker told the sensor's noise) when ``spec`` is ``tracked``, unless the agent handles
-    detections itself (``agent.handles_detections``) or is wrapped already."""
+    its tracker told the sensor's noise and the tracking ``settings``,
+    :func:`tracking_configs`) when ``spec`` is ``tracked``, unless the agent handles detections
+    itself (``agent.handles_detections``) or is wrapped already."""
     from anyplan.agents.perceiving import TrackingAgent
-    from anyplan.prediction.tracking import TrackerConfig
 
     if spec.mode != "tracked" or getattr(agent, "handles_detections", False) \
             or isinstance(agent, TrackingAgent):
         return agent
-    return TrackingAgent(agent, TrackerConfig(sigma_m=spec.noise_m))
+    return TrackingAgent(agent, *tracking_configs(settings or {}, spec.noise_m))

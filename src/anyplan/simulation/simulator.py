@@ -20,7 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from anyplan.agents.base import Agent, AgentStats, Observation
-from anyplan.config import setting, validate
+from anyplan.config import SettingError, setting, validate
+from anyplan.errors import UnknownNameError
 from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.geometry.moving import closest_approach_straight
 from anyplan.planning.time_bound import scenario_time_lower_bound
@@ -34,7 +35,13 @@ from anyplan.simulation.contact import (
 )
 from anyplan.simulation.feasibility import goal_unreachable
 from anyplan.simulation.metrics import moving_obstacle_metrics
-from anyplan.simulation.perception import Sensor, effective_sensing, observe_exact, with_tracking
+from anyplan.simulation.perception import (
+    Sensor,
+    effective_sensing,
+    observe_exact,
+    tracking_configs,
+    with_tracking,
+)
 from anyplan.simulation.result import WALL_CLOCK_FIELDS, RunResult, RunStatus, without_wall_clock
 from anyplan.world.limits import MAX_SIM_STEPS, MAX_TIME_LIMIT_S, MIN_DT_S
 from anyplan.world.motion import Jump
@@ -62,6 +69,11 @@ class SimConfig:
             (:mod:`anyplan.simulation.perception`).
         check_feasibility: Before the first step, end the run with status ``unreachable`` when
             the visibility graph proves the goal out of reach.
+        tracker: With ``tracked`` perception, settings of the robot's tracker and of its
+            uncertain discs as ``(name, value)`` pairs (``anyplan run --tracker KEY=VALUE``;
+            the names: :func:`~anyplan.simulation.perception.tracking_setting_names`); the
+            defaults elsewhere. The run records the settings it used in
+            ``result.extra["perception"]["tracker"]``.
 
     Invalid values raise :class:`~anyplan.config.SettingError` naming the field (``SimConfig.dt``).
     """
@@ -72,9 +84,14 @@ class SimConfig:
     stop_on_collision: bool = setting(True, doc="end the run at the first collision")
     announce_motions: bool = setting(True, doc="observations carry the obstacles' motion models")
     check_feasibility: bool = setting(True, doc="end at once when the goal is proven unreachable")
+    tracker: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
         validate(self)
+        try:
+            tracking_configs(dict(self.tracker), 0.05)
+        except UnknownNameError as exc:
+            raise SettingError("SimConfig", "tracker", str(exc)) from None
 
     def steps(self, scenario_time_limit: float) -> int:
         """Number of simulation steps of a run (``ValueError`` beyond ``MAX_SIM_STEPS``)."""
@@ -310,13 +327,18 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
     wall0 = time.perf_counter()
     sim = Simulation(scenario, config, seed)
     wall_clock_extra = getattr(agent, "wall_clock_extra", ())
-    agent = with_tracking(agent, sim.sensor.spec)
+    agent = with_tracking(agent, sim.sensor.spec, dict(sim.config.tracker))
     agent.stats = AgentStats()
     if not sim.unreachable:
         agent.reset(scenario.static_only(), np.random.default_rng(seed))
     while not sim.done:
         sim.step(agent.act(sim.observation()))
     res = sim.result(agent.name, seed, agent.stats, time.perf_counter() - wall0)
+    from anyplan.agents.perceiving import TrackingAgent
+
+    if isinstance(agent, TrackingAgent):  # the tracker's settings, for reproducing the run
+        res.extra["perception"] = {**res.extra.get("perception", {}),
+                                   "tracker": agent.settings()}
     res.wall_clock_fields += [f"extra.{k}" for k in wall_clock_extra if k in res.extra]
     return res
 
