@@ -60,3 +60,12 @@ def test_run_records_the_tracker_settings_it_used(tmp_path):
     # the given ones, the sensor's noise as the tracker's, the defaults elsewhere
     assert t["q_cv"] == 0.01 and t["k_sigma"] == 1.5 and t["sigma_m"] == 0.2
     assert t["q_ct"] == 0.05 and t["cap_m"] == 1.0
+
+
+@pytest.mark.parametrize("perception", [[], ["--perception", "twist"]])
+def test_tracker_settings_without_tracked_perception_exit_2(tmp_path, capsys, perception):
+    # paper-1 has no sensing block (oracle): nothing would read the settings
+    assert main(["run", "paper-1", "--planner", "straight", "--out", str(tmp_path / "r"),
+                 "--tracker", "q_cv=0.01", *perception]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "tracker settings apply to tracked perception only" in err

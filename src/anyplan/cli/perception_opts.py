@@ -53,15 +53,24 @@ def add_tracker_option(p: argparse.ArgumentParser) -> None:
                         "docs/perception.md, 'Tracker settings')")
 
 
-def tracker_settings(command: str, args: argparse.Namespace) -> tuple[tuple[str, float], ...]:
+def tracker_settings(command: str, args: argparse.Namespace,
+                     scenario: Scenario | None = None) -> tuple[tuple[str, float], ...]:
     """The ``--tracker`` settings as ``(name, value)`` pairs.
 
     Raises:
-        UsageError: a malformed item, an unknown name or a value out of range (exit code 2).
+        UsageError: a malformed item, an unknown name, a value out of range, or settings for
+            a ``scenario`` (its perception options applied) whose perception is not
+            ``tracked``, where nothing would read them (exit code 2).
     """
     from anyplan.simulation.perception import parse_tracking_settings
 
     try:
-        return parse_tracking_settings(args.tracker)
+        out = parse_tracking_settings(args.tracker)
     except ValueError as exc:
         raise UsageError(f"{command}: --tracker: {exc}") from None
+    mode = "oracle" if scenario is None or scenario.sensing is None else scenario.sensing.mode
+    if out and scenario is not None and mode != "tracked":
+        raise UsageError(f"{command}: --tracker: {scenario.name}'s perception is '{mode}'; "
+                         "tracker settings apply to tracked perception only "
+                         "(--perception tracked)")
+    return out

@@ -150,7 +150,8 @@ def tracking_setting_names() -> tuple[str, ...]:
     return tuple(f.name for f in fields(TrackerConfig)) + _UNCERTAINTY_FIELDS
 
 
-_UNCERTAINTY_FIELDS = ("k_sigma", "accel_allowance", "cap_m", "turn_confidence")
+#: The uncertainty model's settings (its scalar fields; the horizon knots are not one).
+_UNCERTAINTY_FIELDS = tuple(f.name for f in fields(UncertaintyModel) if f.name != "taus")
 
 
 def tracking_configs(settings: Mapping[str, float], noise_m: float
