@@ -20,6 +20,7 @@ from dataclasses import fields, replace
 import numpy as np
 
 from anyplan.agents.base import Agent
+from anyplan.agents.perceiving import TrackingAgent
 from anyplan.errors import UnknownNameError
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.prediction.base import ObstacleObservation
@@ -209,8 +210,6 @@ def with_tracking(agent: Agent, spec: SensingSpec,
     its tracker told the sensor's noise and the tracking ``settings``,
     :func:`tracking_configs`) when ``spec`` is ``tracked``, unless the agent handles detections
     itself (``agent.handles_detections``) or is wrapped already."""
-    from anyplan.agents.perceiving import TrackingAgent
-
     if spec.mode != "tracked" or getattr(agent, "handles_detections", False) \
             or isinstance(agent, TrackingAgent):
         return agent

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from anyplan.agents.base import Agent, AgentStats, Observation
+from anyplan.agents.perceiving import TrackingAgent
 from anyplan.config import SettingError, setting, validate
 from anyplan.errors import UnknownNameError
 from anyplan.geometry.collision import COLLISION_EPS
@@ -334,11 +335,8 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
     while not sim.done:
         sim.step(agent.act(sim.observation()))
     res = sim.result(agent.name, seed, agent.stats, time.perf_counter() - wall0)
-    from anyplan.agents.perceiving import TrackingAgent
-
     if isinstance(agent, TrackingAgent):  # the tracker's settings, for reproducing the run
-        res.extra["perception"] = {**res.extra.get("perception", {}),
-                                   "tracker": agent.settings()}
+        res.extra["perception"]["tracker"] = agent.settings()
     res.wall_clock_fields += [f"extra.{k}" for k in wall_clock_extra if k in res.extra]
     return res
 
