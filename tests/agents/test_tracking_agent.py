@@ -8,6 +8,8 @@ from anyplan.agents import make_agent
 from anyplan.agents.base import Agent, Observation
 from anyplan.agents.perceiving import TrackingAgent
 from anyplan.prediction.detection import Detection
+from anyplan.prediction.tracking import TrackerConfig
+from anyplan.prediction.uncertain import UncertaintyModel
 from anyplan.simulation import SimConfig, simulate
 from anyplan.world import Command, RobotState, scenario_from_dict
 from tests.conftest import small_scenario_dict
@@ -61,6 +63,37 @@ def test_detection_leaving_the_tube_requests_a_replan():
     ag.act(Observation(2.1, robot, (), (Detection("a", 2.1, 2.1, 2.5, 0.3),)))
     assert len(spy.replans) == 1 and "left its predicted tube" in spy.replans[0]
     assert ag.tube_exits == 1
+
+
+def _drift_run(tube_cap_m: float, offset_m: float) -> tuple[Spy, TrackingAgent]:
+    """A track straight at 1 m/s along y = 1, planned against at 0.9 s, then detected at 2.0 s
+    ``offset_m`` [m] off its line (sideways: it has turned)."""
+    spy = Spy()
+    spy.plan_at = 10
+    ag = TrackingAgent(spy, uncertainty=UncertaintyModel(tube_cap_m=tube_cap_m))
+    ag.reset(scenario_from_dict(small_scenario_dict()), np.random.default_rng(0))
+    robot = RobotState(1.0, 3.0, 0.0)
+    for k in range(20):
+        t = 0.1 * k
+        ag.act(Observation(t, robot, (), (Detection("a", t, t, 1.0, 0.3),)))
+    ag.act(Observation(2.0, robot, (), (Detection("a", 2.0, 2.0, 1.0 + offset_m, 0.3),)))
+    return spy, ag
+
+
+def test_the_replan_tube_is_capped_narrower_than_the_planned_disc():
+    sigma3 = 3.0 * TrackerConfig().sigma_m
+    cap = UncertaintyModel().tube_cap_m
+    offset = cap + sigma3 + 0.05  # outside the capped tube
+    spy, ag = _drift_run(cap, offset)
+    assert spy.replans and "left its predicted tube" in spy.replans[0] and ag.tube_exits == 1
+    # ... but inside the disc planned against: only the cap made it leave
+    spy_wide, ag_wide = _drift_run(10.0, offset)
+    p = ag_wide._tube["a"]
+    assert offset < float(p.radius_at(2.0)) - p.radius + sigma3
+    assert spy_wide.replans == [] and ag_wide.tube_exits == 0
+    # and within the capped tube nothing is requested
+    spy_in, _ = _drift_run(cap, cap + sigma3 - 0.05)
+    assert spy_in.replans == []
 
 
 def test_seq_bitstar_and_dovs_run_in_tracked_mode():

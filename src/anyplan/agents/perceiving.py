@@ -11,8 +11,11 @@ the same uncertain predictions, through its usual predictor.
 
 **Leaving the tube.** When the inner agent plans (its count of planning calls grows), the wrapper
 keeps the predictions it planned against. A later detection farther from its predicted centre
-than the grown radius plus three noise standard deviations has left the predicted tube: the
-wrapper asks the inner agent to replan (``request_replan(reason)``, if it has one) and counts it.
+than the grown extra radius, capped at ``UncertaintyModel.tube_cap_m``, plus three noise standard
+deviations has left the predicted tube: the wrapper asks the inner agent to replan
+(``request_replan(reason)``, if it has one) and counts it. The tube is narrower than the planned
+disc: the disc must hold where the obstacle may be (up to 1 m wide at 2 s), but an obstacle
+already 0.3 m off its predicted line has most likely turned, and the plan should know it.
 """
 
 from __future__ import annotations
@@ -83,12 +86,13 @@ class TrackingAgent(Agent):
 
     def _check_tube(self, obs: Observation) -> str | None:
         k = 3.0 * max(self.tracker_config.sigma_m, 1e-3)
+        cap = self.uncertainty.tube_cap_m
         for d in obs.detections:
             p = self._tube.get(d.name)
             if p is None:
                 continue
             c = p.positions(np.array([d.t]))[0]
-            if math.hypot(d.x - c[0], d.y - c[1]) > float(p.radius_at(d.t)) - p.radius + k:
+            if math.hypot(d.x - c[0], d.y - c[1]) > min(float(p.radius_at(d.t)) - p.radius, cap) + k:
                 return d.name
         return None
 

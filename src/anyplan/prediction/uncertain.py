@@ -38,6 +38,10 @@ class UncertaintyModel:
         taus: Horizon knots [s] (increasing, from 0; the last is the horizon cap).
         turn_confidence: The track's turn rate is predicted only when its CT model's probability
             is at least this; below it the track is predicted straight.
+        tube_cap_m: Largest extra radius [m] of the replan tube: a detection farther from its
+            predicted centre than ``min(extra, tube_cap_m)`` plus three noise standard
+            deviations has left the tube, and the robot replans (the planned disc keeps the
+            whole ``extra``; replanning costs little, a stale plan near a turning obstacle a lot).
 
     Invalid values raise :class:`~anyplan.config.SettingError` naming the field.
     """
@@ -48,6 +52,8 @@ class UncertaintyModel:
     taus: tuple[float, ...] = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0)
     turn_confidence: float = setting(0.7, lo=0.0, hi=1.0, unit="",
                                      doc="P(CT) from which the turn rate is predicted")
+    tube_cap_m: float = setting(0.3, lo=0.0, unit="m",
+                                doc="largest extra radius of the replan tube")
 
     def __post_init__(self) -> None:
         validate(self)
