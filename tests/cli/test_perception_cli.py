@@ -63,9 +63,37 @@ def test_run_records_the_tracker_settings_it_used(tmp_path):
 
 
 @pytest.mark.parametrize("perception", [[], ["--perception", "twist"]])
-def test_tracker_settings_without_tracked_perception_exit_2(tmp_path, capsys, perception):
+@pytest.mark.parametrize("command", ["run", "bench"])
+def test_tracker_settings_without_tracked_perception_exit_2(tmp_path, capsys, perception, command):
     # paper-1 has no sensing block (oracle): nothing would read the settings
-    assert main(["run", "paper-1", "--planner", "straight", "--out", str(tmp_path / "r"),
-                 "--tracker", "q_cv=0.01", *perception]) == 2
+    base = (["run", "paper-1", "--planner", "straight", "--out", str(tmp_path / "r")]
+            if command == "run" else
+            ["bench", "--suite", "paper-1", "--planners", "straight", "--runs", "1", "--jobs",
+             "1", "--db", str(tmp_path / "x.db"), "--no-progress"])
+    assert main([*base, "--tracker", "q_cv=0.01", *perception]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "tracker settings apply to tracked perception only" in err
+    assert not (tmp_path / "x.db").exists() and not (tmp_path / "r").exists()
+
+
+def test_bench_keeps_runs_with_other_tracker_settings_apart(tmp_path, capsys):
+    db = tmp_path / "x.db"
+
+    def bench(*tracker: str) -> int:
+        argv = ["bench", "--suite", "paper-1", "--planners", "straight", "--runs", "1", "--jobs",
+                "1", "--db", str(db), "--no-progress", "--perception", "tracked",
+                "--time-limit", "1"]
+        return main(argv + [a for t in tracker for a in ("--tracker", t)])
+
+    assert bench("q_cv=0.01", "k_sigma=1.5") == 0
+    assert bench("k_sigma=1.5", "q_cv=0.01") == 2  # the same settings: stored already
+    assert "already holds 1 of these 1 runs" in capsys.readouterr().err
+    assert bench("q_cv=0.02") == 0  # other settings: another planner row, its own run
+    from anyplan.experiments.db import ResultsDB
+
+    with ResultsDB(db, readonly=True) as d:
+        runs = sorted(d.runs(), key=lambda r: r["settings"])
+        assert [r["settings"] for r in runs] == ["tracker.k_sigma = 1.5;tracker.q_cv = 0.01;",
+                                                 "tracker.q_cv = 0.02;"]
+        used = [d.result(r["id"])["extra"]["perception"]["tracker"] for r in runs]
+    assert [(u["q_cv"], u["k_sigma"]) for u in used] == [(0.01, 1.5), (0.02, 2.0)]

@@ -53,9 +53,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--time-limit", type=checks.time_limit, default=None,
                    help="simulated time limit [s] (default: each scenario's)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    from anyplan.cli.perception_opts import add_perception_options
+    from anyplan.cli.perception_opts import add_perception_options, add_tracker_option
 
     add_perception_options(p)
+    add_tracker_option(p)
     add_agent_options(p, bench=True)
     p.set_defaults(func=_database_errors(cmd_bench))
 
@@ -133,7 +134,7 @@ def _usage(msg: str) -> Exception:
 
 def cmd_bench(args: argparse.Namespace) -> int:
     """Run the bench, then print and write the tables."""
-    from anyplan.experiments.db import ResultsDB, settings_string
+    from anyplan.experiments.db import ResultsDB, agent_settings_string
     from anyplan.experiments.runner import BenchInterrupted, parse_planners, run_bench
     from anyplan.experiments.suites import resolve_suite
     from anyplan.experiments.tables import (
@@ -161,9 +162,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
         planners = [PlannerSpec(p.name, cfgs[p.name]) for p in planners]
     scenarios = resolve_suite(args.suite, random_seed=args.seed if args.random_seed is None
                               else args.random_seed, per_count=args.random_count)
-    from anyplan.cli.perception_opts import apply_perception
+    from anyplan.cli.perception_opts import apply_perception, tracker_settings
 
     scenarios = apply_perception("bench", scenarios, args)
+    tracker = tracker_settings("bench", args, scenarios)
     n_tasks = args.runs * len(scenarios) * len(planners)
     if n_tasks > checks.MAX_TASKS:
         raise _usage(f"bench: {args.runs} runs x {len(scenarios)} scenarios x {len(planners)} "
@@ -171,7 +173,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from anyplan.simulation.simulator import SimConfig
 
     try:
-        cfg = SimConfig(dt=args.dt, time_limit=args.time_limit)
+        cfg = SimConfig(dt=args.dt, time_limit=args.time_limit, tracker=tracker)
         for sc in scenarios:
             cfg.steps(sc.time_limit)
     except ValueError as exc:
@@ -191,7 +193,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         sys.stderr.write(f"anyplan: bench stopped: {exc}\n")
         return 1
     hashes = {sc.content_hash() for sc in scenarios}
-    configs = {(p.name, settings_string(p.config)) for p in planners}
+    configs = {(p.name, agent_settings_string(p.config, tracker)) for p in planners}
     with ResultsDB(db_path, readonly=True) as db:
         runs = [r for r in db.runs()
                 if r["scenario_hash"] in hashes and str(r["experiment_seed"]) == str(args.seed)

@@ -115,7 +115,7 @@ def _compiling_notice() -> None:
 def _run(args: argparse.Namespace) -> int:
     scenario = apply_perception("run", [load_scenario(args.scenario)], args)[0]
     config = run_config(args, args.planner)  # unknown names and bad settings fail before any work
-    tracker = tracker_settings("run", args, scenario)
+    tracker = tracker_settings("run", args, [scenario])
     try:
         cfg = SimConfig(dt=args.dt, time_limit=args.time_limit, tracker=tracker)
         cfg.steps(scenario.time_limit)

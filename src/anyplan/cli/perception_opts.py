@@ -54,12 +54,12 @@ def add_tracker_option(p: argparse.ArgumentParser) -> None:
 
 
 def tracker_settings(command: str, args: argparse.Namespace,
-                     scenario: Scenario | None = None) -> tuple[tuple[str, float], ...]:
+                     scenarios: Sequence[Scenario] = ()) -> tuple[tuple[str, float], ...]:
     """The ``--tracker`` settings as ``(name, value)`` pairs.
 
     Raises:
-        UsageError: a malformed item, an unknown name, a value out of range, or settings for
-            a ``scenario`` (its perception options applied) whose perception is not
+        UsageError: a malformed item, an unknown name, a value out of range, or settings with
+            one of ``scenarios`` (their perception options applied) whose perception is not
             ``tracked``, where nothing would read them (exit code 2).
     """
     from anyplan.simulation.perception import parse_tracking_settings
@@ -68,9 +68,10 @@ def tracker_settings(command: str, args: argparse.Namespace,
         out = parse_tracking_settings(args.tracker)
     except ValueError as exc:
         raise UsageError(f"{command}: --tracker: {exc}") from None
-    mode = "oracle" if scenario is None or scenario.sensing is None else scenario.sensing.mode
-    if out and scenario is not None and mode != "tracked":
-        raise UsageError(f"{command}: --tracker: {scenario.name}'s perception is '{mode}'; "
-                         "tracker settings apply to tracked perception only "
-                         "(--perception tracked)")
+    for scenario in scenarios if out else ():
+        mode = "oracle" if scenario.sensing is None else scenario.sensing.mode
+        if mode != "tracked":
+            raise UsageError(f"{command}: --tracker: {scenario.name}'s perception is '{mode}'; "
+                             "tracker settings apply to tracked perception only "
+                             "(--perception tracked)")
     return out

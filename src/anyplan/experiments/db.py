@@ -18,7 +18,7 @@ import math
 import platform
 import sqlite3
 import zlib
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
@@ -39,6 +39,7 @@ from anyplan.trajectory.path import polyline_length
 
 __all__ = [
     "ResultsDB",
+    "agent_settings_string",
     "STATUS",
     "STATUS_OF_OUTCOME",
     "RUN_COLUMNS",
@@ -86,6 +87,14 @@ _EXPERIMENT_EXTRA = [("scenario_hash", "TEXT"), ("moving_obstacles", "INTEGER"),
 def settings_string(config: Mapping[str, Any]) -> str:
     """OMPL-style planner settings: ``"key = value;"`` per entry, sorted; empty for {}."""
     return "".join(f"{k} = {json.dumps(config[k], sort_keys=True)};" for k in sorted(config))
+
+
+def agent_settings_string(config: Mapping[str, Any], tracker: Sequence[tuple[str, float]] = ()) -> str:
+    """The settings string of a benchmarked agent: its planner's (:func:`settings_string`), then
+    its tracker's (``SimConfig.tracker``, ``anyplan bench --tracker``) as ``tracker.NAME = VALUE;``
+    in name order, so that runs with other tracker settings are another planner row."""
+    return settings_string(config) + "".join(
+        f"tracker.{k} = {json.dumps(float(v))};" for k, v in sorted(tracker))
 
 
 def _fin(x: Any) -> float | None:

@@ -30,7 +30,7 @@ import numpy as np
 
 from anyplan.agents.base import AGENTS, make_agent
 from anyplan.errors import AnyplanError
-from anyplan.experiments.db import ExperimentKey, ResultsDB, run_row, settings_string
+from anyplan.experiments.db import ExperimentKey, ResultsDB, agent_settings_string, run_row, settings_string
 from anyplan.experiments.progress import ProgressBar
 from anyplan.simulation.simulator import SimConfig, simulate
 from anyplan.world.scenario import Scenario
@@ -326,7 +326,9 @@ def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], ru
             exp_ids[h] = db.experiment_id(key, scenario_json=json.dumps(sc.to_dict()),
                                           moving_obstacles=len(sc.moving_obstacles), runcount=runs,
                                           suite=suite)
-        plan_ids = {(p.name, p.settings): db.planner_id(p.name, p.settings) for p in planners}
+        # the tracker's settings (the same for every task) are part of each planner's row
+        plan_ids = {(p.name, settings_string(p.config)): db.planner_id(
+            p.name, agent_settings_string(p.config, sim.tracker)) for p in planners}
         done = db.done_keys()
         tasks = []
         for t in all_tasks:
