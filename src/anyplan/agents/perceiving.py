@@ -29,7 +29,7 @@ from anyplan.agents.base import Agent, AgentStats, Observation
 from anyplan.agents.stats import TrackerCounts
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
 from anyplan.prediction.tracking import Tracker, TrackerConfig
-from anyplan.prediction.uncertain import UncertaintyModel
+from anyplan.prediction.uncertain import UNCERTAINTY_SETTINGS, UncertaintyModel
 from anyplan.world.robot import Command
 from anyplan.world.scenario import Scenario
 
@@ -80,8 +80,7 @@ class TrackingAgent(Agent):
         run records to be reproduced)."""
         out = {f.name: float(getattr(self.tracker_config, f.name))
                for f in fields(self.tracker_config)}
-        out.update({f.name: float(getattr(self.uncertainty, f.name))
-                    for f in fields(self.uncertainty) if f.name != "taus"})
+        out.update({name: float(getattr(self.uncertainty, name)) for name in UNCERTAINTY_SETTINGS})
         return out
 
     def _check_tube(self, obs: Observation) -> str | None:

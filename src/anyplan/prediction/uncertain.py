@@ -16,7 +16,7 @@ Why the turn rate is gated, the knots and the coverage bound: ``docs/perception.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -24,7 +24,7 @@ from anyplan.config import setting, validate
 from anyplan.prediction.base import ObstacleObservation, RadiusGrowth
 from anyplan.prediction.tracking import TrackEstimate, ct_transition
 
-__all__ = ["UncertaintyModel"]
+__all__ = ["UncertaintyModel", "UNCERTAINTY_SETTINGS"]
 
 
 @dataclass(frozen=True)
@@ -92,3 +92,9 @@ class UncertaintyModel:
                                            e.speed, float(x[4]), e.radius, None,
                                            RadiusGrowth(e.t, taus, row)))
         return tuple(out)
+
+
+#: The model's settings by name: its scalar fields (the horizon knots ``taus`` are its shape,
+#: not a setting), what ``--tracker`` may set and a run records.
+UNCERTAINTY_SETTINGS: tuple[str, ...] = tuple(
+    f.name for f in fields(UncertaintyModel) if f.name != "taus")

@@ -26,7 +26,7 @@ from anyplan.geometry.collision import ObstacleSet
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.prediction.detection import Detection
 from anyplan.prediction.tracking import TrackerConfig
-from anyplan.prediction.uncertain import UncertaintyModel
+from anyplan.prediction.uncertain import UNCERTAINTY_SETTINGS, UncertaintyModel
 from anyplan.world.robot import RobotState
 from anyplan.world.scenario import Scenario
 from anyplan.world.sensing import SensingSpec
@@ -148,11 +148,9 @@ def tracking_setting_names() -> tuple[str, ...]:
     """The names a tracking setting may have: the fields of
     :class:`~anyplan.prediction.tracking.TrackerConfig` (the tracker) and the scalar fields of
     :class:`~anyplan.prediction.uncertain.UncertaintyModel` (the growing disc)."""
-    return tuple(f.name for f in fields(TrackerConfig)) + _UNCERTAINTY_FIELDS
+    return tuple(f.name for f in fields(TrackerConfig)) + UNCERTAINTY_SETTINGS
 
 
-#: The uncertainty model's settings (its scalar fields; the horizon knots are not one).
-_UNCERTAINTY_FIELDS = tuple(f.name for f in fields(UncertaintyModel) if f.name != "taus")
 
 
 def tracking_configs(settings: Mapping[str, float], noise_m: float
@@ -170,9 +168,9 @@ def tracking_configs(settings: Mapping[str, float], noise_m: float
     for name in settings:
         if name not in known:
             raise UnknownNameError("tracker setting", name, list(known))
-    tracker = {k: float(v) for k, v in settings.items() if k not in _UNCERTAINTY_FIELDS}
+    tracker = {k: float(v) for k, v in settings.items() if k not in UNCERTAINTY_SETTINGS}
     tracker.setdefault("sigma_m", float(noise_m))
-    disc = {k: float(v) for k, v in settings.items() if k in _UNCERTAINTY_FIELDS}
+    disc = {k: float(v) for k, v in settings.items() if k in UNCERTAINTY_SETTINGS}
     return TrackerConfig(**tracker), UncertaintyModel(**disc)  # type: ignore[arg-type]
 
 
