@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from anyplan.world.motion import UnicycleMotion, WaypointMotion
+from anyplan.world.motion import TrackMotion, UnicycleMotion, WaypointMotion
 
 
 @settings(max_examples=100, deadline=None)
@@ -64,3 +64,38 @@ def test_waypoint_motion_loops_and_hits_keyframes_exactly():
     assert m.max_speed == pytest.approx(math.hypot(2.0, 3.0) / 3.0)
     with pytest.raises(ValueError, match="keyframe times must start at 0 and increase strictly"):
         WaypointMotion(np.array([[0.0, 0, 0], [0.0, 1, 1]]))
+
+
+@st.composite
+def _tracks(draw):
+    """Keyframes (t, x, y): 2-12 rows, times strictly increasing, from a first time."""
+    n = draw(st.integers(2, 12))
+    gaps = draw(st.lists(st.floats(1e-3, 10), min_size=n - 1, max_size=n - 1))
+    xy = draw(st.lists(st.tuples(st.floats(-50, 50), st.floats(-50, 50)), min_size=n, max_size=n))
+    t0 = draw(st.floats(-100, 100))
+    t = np.concatenate([[0.0], np.cumsum(gaps)])
+    return t0, np.column_stack([t, np.array(xy)])
+
+
+@settings(max_examples=200, deadline=None)
+@given(track=_tracks(), u=st.lists(st.floats(-0.5, 3.0), min_size=1, max_size=8),
+       at_knot=st.integers(0, 11))
+def test_one_time_gives_the_bits_of_the_array_path(track, u, at_knot):
+    # position(t) and state(t) take a scalar path (the simulator's, every step); they must give
+    # exactly what positions() gives, at knots (where segments meet), between them, before the
+    # track, after it and, for a looping track, in later periods.
+    t0, k = track
+    loop = WaypointMotion(k)
+    rec = TrackMotion(np.column_stack([k[:, 0] + t0, k[:, 1:]]))
+    for m, first in ((loop, 0.0), (rec, t0)):
+        span = float(k[-1, 0])
+        knot = first + float(k[min(at_knot, len(k) - 1), 0])
+        times = [first + f * span for f in u] + [knot, np.nextafter(knot, -np.inf),
+                                                 np.nextafter(knot, np.inf)]
+        for t in times:
+            want = m.positions(np.array([t]))[0]
+            got = m.position(t)
+            assert got[0] == want[0] and got[1] == want[1], (t, got, want)
+            x, y, th, v, _ = m.state(t)
+            assert (x, y) == (want[0], want[1])
+            assert math.isfinite(th) and v >= 0.0

@@ -14,6 +14,7 @@ A moving obstacle follows its motion whatever is in its way (it is not reactive)
 
 from __future__ import annotations
 
+import bisect
 import functools
 import math
 from dataclasses import dataclass
@@ -143,6 +144,48 @@ class UnicycleMotion(Motion):
         return np.array([self.x0 - r * math.sin(self.theta0), self.y0 + r * math.cos(self.theta0)])
 
 
+def _interp1(x: float, ts: tuple[float, ...], vs: tuple[float, ...]) -> float:
+    """``np.interp(x, ts, vs)`` for one time ``x`` [s], by the same operations in the same order
+    (the same bits), without numpy's per-call set-up: the simulator asks every obstacle for its
+    position and twist at every step, one time at a time."""
+    if x != x:
+        return x  # nan
+    if x < ts[0]:
+        return vs[0]
+    if x >= ts[-1]:
+        return vs[-1]
+    j = bisect.bisect_right(ts, x) - 1
+    if ts[j] == x:
+        return vs[j]
+    slope = (vs[j + 1] - vs[j]) / (ts[j + 1] - ts[j])
+    out = slope * (x - ts[j]) + vs[j]
+    if out != out:  # as numpy: from the other end, then the constant piece
+        out = slope * (x - ts[j + 1]) + vs[j + 1]
+        if out != out and vs[j] == vs[j + 1]:
+            out = vs[j]
+    return out
+
+
+class _Keyframes(NamedTuple):
+    """A track's columns as tuples of floats, for :func:`_interp1`."""
+
+    t: tuple[float, ...]
+    x: tuple[float, ...]
+    y: tuple[float, ...]
+
+
+def _columns(k: np.ndarray) -> _Keyframes:
+    return _Keyframes(*(tuple(float(v) for v in k[:, c]) for c in range(3)))
+
+
+def _segment_twist(kf: _Keyframes, t: float) -> tuple[float, float]:
+    """The velocity (vx, vy) [m/s] of the track's segment at time ``t`` [s] (the first before
+    the track, the last after it)."""
+    i = min(max(bisect.bisect_right(kf.t, t) - 1, 0), len(kf.t) - 2)
+    dt = kf.t[i + 1] - kf.t[i]
+    return (kf.x[i + 1] - kf.x[i]) / dt, (kf.y[i + 1] - kf.y[i]) / dt
+
+
 def _track_speed(k: np.ndarray) -> float:
     """Largest speed [m/s] of a piecewise-linear track, rows (t, x, y)."""
     seg = np.hypot(np.diff(k[:, 1]), np.diff(k[:, 2])) / np.diff(k[:, 0])
@@ -169,6 +212,7 @@ class WaypointMotion(Motion):
         k.setflags(write=False)
         object.__setattr__(self, "keyframes", k)
         object.__setattr__(self, "_vmax", _track_speed(k))  # asked for by every prediction check
+        object.__setattr__(self, "_kf", _columns(k))
 
     @property
     def period(self) -> float:
@@ -199,15 +243,20 @@ class WaypointMotion(Motion):
         k = self.keyframes
         return np.column_stack([np.interp(tm, k[:, 0], k[:, 1]), np.interp(tm, k[:, 0], k[:, 2])])
 
+    def position(self, t: float) -> np.ndarray:
+        x, y = self._xy(float(t) % self.period)
+        return np.array((x, y))
+
+    def _xy(self, tm: float) -> tuple[float, float]:
+        kf: _Keyframes = self._kf  # type: ignore[attr-defined]  # set in __post_init__ (frozen)
+        return _interp1(tm, kf.t, kf.x), _interp1(tm, kf.t, kf.y)
+
     def state(self, t: float) -> tuple[float, float, float, float, float]:
-        tm = float(np.mod(t, self.period))
-        k = self.keyframes
-        i = int(np.clip(np.searchsorted(k[:, 0], tm, side="right") - 1, 0, len(k) - 2))
-        dt = k[i + 1, 0] - k[i, 0]
-        vx = (k[i + 1, 1] - k[i, 1]) / dt
-        vy = (k[i + 1, 2] - k[i, 2]) / dt
-        x, y = self.position(t)
-        return float(x), float(y), math.atan2(vy, vx), math.hypot(vx, vy), 0.0
+        kf: _Keyframes = self._kf  # type: ignore[attr-defined]
+        tm = float(t) % kf.t[-1]
+        vx, vy = _segment_twist(kf, tm)
+        x, y = self._xy(tm)
+        return x, y, math.atan2(vy, vx), math.hypot(vx, vy), 0.0
 
 
 @dataclass(frozen=True)
@@ -231,6 +280,7 @@ class TrackMotion(Motion):
         object.__setattr__(self, "samples", k)
         object.__setattr__(self, "span", (float(k[0, 0]), float(k[-1, 0])))
         object.__setattr__(self, "_vmax", _track_speed(k))
+        object.__setattr__(self, "_kf", _columns(k))
 
     @property
     def max_speed(self) -> float:  # type: ignore[override]
@@ -241,13 +291,16 @@ class TrackMotion(Motion):
         k = self.samples
         return np.column_stack([np.interp(tt, k[:, 0], k[:, 1]), np.interp(tt, k[:, 0], k[:, 2])])
 
+    def position(self, t: float) -> np.ndarray:
+        kf: _Keyframes = self._kf  # type: ignore[attr-defined]  # set in __post_init__ (frozen)
+        t = float(t)
+        return np.array((_interp1(t, kf.t, kf.x), _interp1(t, kf.t, kf.y)))
+
     def state(self, t: float) -> tuple[float, float, float, float, float]:
-        k = self.samples
-        i = int(np.clip(np.searchsorted(k[:, 0], t, side="right") - 1, 0, len(k) - 2))
-        dt = k[i + 1, 0] - k[i, 0]
-        vx = (k[i + 1, 1] - k[i, 1]) / dt
-        vy = (k[i + 1, 2] - k[i, 2]) / dt
-        x, y = self.position(t)
+        kf: _Keyframes = self._kf  # type: ignore[attr-defined]
+        t = float(t)
+        vx, vy = _segment_twist(kf, t)
+        x, y = _interp1(t, kf.t, kf.x), _interp1(t, kf.t, kf.y)
         if not self.span[0] <= t < self.span[1]:
-            return float(x), float(y), math.atan2(vy, vx), 0.0, 0.0
-        return float(x), float(y), math.atan2(vy, vx), math.hypot(vx, vy), 0.0
+            return x, y, math.atan2(vy, vx), 0.0, 0.0
+        return x, y, math.atan2(vy, vx), math.hypot(vx, vy), 0.0
