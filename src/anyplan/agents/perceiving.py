@@ -9,13 +9,11 @@ twist of the mean, no motion model) carrying the growth of their uncertain disc
 (:class:`~anyplan.prediction.uncertain.UncertaintyModel`). Every planner therefore plans against
 the same uncertain predictions, through its usual predictor.
 
-**Leaving the tube.** When the inner agent plans (its count of planning calls grows), the wrapper
-keeps the predictions it planned against. A later detection farther from its predicted centre
-than the grown extra radius, capped at ``UncertaintyModel.tube_cap_m``, plus three noise standard
-deviations has left the predicted tube: the wrapper asks the inner agent to replan
-(``request_replan(reason)``, if it has one) and counts it. The tube is narrower than the planned
-disc: the disc must hold where the obstacle may be (up to 1 m wide at 2 s), but an obstacle
-already 0.3 m off its predicted line has most likely turned, and the plan should know it.
+**Leaving the tube.** The wrapper keeps the predictions the inner agent last planned against. A
+detection farther from its predicted centre than the extra radius capped at
+``UncertaintyModel.tube_cap_m``, plus 3 noise standard deviations, has left the tube: the wrapper
+asks the agent to replan (``request_replan(reason)``, if it has one) and counts it. Why the tube
+is narrower than the planned disc: ``docs/perception.md``, "Leaving the tube".
 """
 
 from __future__ import annotations
