@@ -26,8 +26,8 @@ Usage::
 
 ``--set`` and ``--deterministic`` are ``anyplan bench``'s (agent settings; a fixed planning delay
 and budgets, so that a run depends only on its scenario, settings and seed, not on the load).
-``--tracker`` is ``anyplan run``'s: settings of the tracker and its uncertain discs for every
-``tracked`` run and for the prediction scores.
+``--tracker`` is ``anyplan run``'s and ``anyplan bench``'s: settings of the tracker and its
+uncertain discs for every ``tracked`` run and for the prediction scores.
 """
 
 from __future__ import annotations

@@ -151,8 +151,6 @@ def tracking_setting_names() -> tuple[str, ...]:
     return tuple(f.name for f in fields(TrackerConfig)) + UNCERTAINTY_SETTINGS
 
 
-
-
 def tracking_configs(settings: Mapping[str, float], noise_m: float
                      ) -> tuple[TrackerConfig, UncertaintyModel]:
     """The tracker's settings and its uncertainty model from ``settings`` (name -> value; see

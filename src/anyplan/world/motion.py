@@ -178,6 +178,11 @@ def _columns(k: np.ndarray) -> _Keyframes:
     return _Keyframes(*(tuple(float(v) for v in k[:, c]) for c in range(3)))
 
 
+def _point(kf: _Keyframes, t: float) -> tuple[float, float]:
+    """The track's position (x, y) [m] at time ``t`` [s], as ``np.interp`` of its columns."""
+    return _interp1(t, kf.t, kf.x), _interp1(t, kf.t, kf.y)
+
+
 def _segment_twist(kf: _Keyframes, t: float) -> tuple[float, float]:
     """The velocity (vx, vy) [m/s] of the track's segment at time ``t`` [s] (the first before
     the track, the last after it)."""
@@ -244,18 +249,14 @@ class WaypointMotion(Motion):
         return np.column_stack([np.interp(tm, k[:, 0], k[:, 1]), np.interp(tm, k[:, 0], k[:, 2])])
 
     def position(self, t: float) -> np.ndarray:
-        x, y = self._xy(float(t) % self.period)
-        return np.array((x, y))
-
-    def _xy(self, tm: float) -> tuple[float, float]:
         kf: _Keyframes = self._kf  # type: ignore[attr-defined]  # set in __post_init__ (frozen)
-        return _interp1(tm, kf.t, kf.x), _interp1(tm, kf.t, kf.y)
+        return np.array(_point(kf, float(t) % kf.t[-1]))
 
     def state(self, t: float) -> tuple[float, float, float, float, float]:
         kf: _Keyframes = self._kf  # type: ignore[attr-defined]
         tm = float(t) % kf.t[-1]
         vx, vy = _segment_twist(kf, tm)
-        x, y = self._xy(tm)
+        x, y = _point(kf, tm)
         return x, y, math.atan2(vy, vx), math.hypot(vx, vy), 0.0
 
 
@@ -293,14 +294,13 @@ class TrackMotion(Motion):
 
     def position(self, t: float) -> np.ndarray:
         kf: _Keyframes = self._kf  # type: ignore[attr-defined]  # set in __post_init__ (frozen)
-        t = float(t)
-        return np.array((_interp1(t, kf.t, kf.x), _interp1(t, kf.t, kf.y)))
+        return np.array(_point(kf, float(t)))
 
     def state(self, t: float) -> tuple[float, float, float, float, float]:
         kf: _Keyframes = self._kf  # type: ignore[attr-defined]
         t = float(t)
         vx, vy = _segment_twist(kf, t)
-        x, y = _interp1(t, kf.t, kf.x), _interp1(t, kf.t, kf.y)
+        x, y = _point(kf, t)
         if not self.span[0] <= t < self.span[1]:
             return x, y, math.atan2(vy, vx), 0.0, 0.0
         return x, y, math.atan2(vy, vx), math.hypot(vx, vy), 0.0
