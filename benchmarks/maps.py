@@ -200,20 +200,6 @@ def static_section(maps_dir: Path, quick: bool, seeds: int) -> list[dict[str, An
     return rows
 
 
-def _robot_caused(sc: Scenario, res: Any) -> bool | None:
-    if not res.collision:
-        return None
-    traj = res.trajectory_array
-    t = res.collision_time_s
-    row = traj[min(np.searchsorted(traj[:, 0], t), len(traj) - 1)]
-    v = np.array([math.cos(row[3]), math.sin(row[3])]) * row[4]
-    for o in sc.moving_obstacles:
-        if o.name == res.collision_with:
-            d = o.position(t) - row[1:3]
-            return bool(v @ d / max(float(np.hypot(*d)), 1e-12) > 0.05)
-    return bool(abs(row[4]) > 0.05)  # a map cell, a wall or a static shape
-
-
 def _drive(sc: Scenario, planners: list[str], runs: int, label: str,
            configs: dict[str, dict[str, Any]], perception: str | None = None) -> list[dict[str, Any]]:
     if perception is not None:
@@ -240,7 +226,7 @@ def _drive(sc: Scenario, planners: list[str], runs: int, label: str,
                     if not imp]  # st-bitstar's improvement calls apart
             reached += bool(res.reached_goal)
             coll += bool(res.collision)
-            caused += bool(_robot_caused(sc, res))
+            caused += bool(res.collision_robot_caused)  # the simulator's classification
             if res.time_to_goal_s is not None:
                 ttg.append(res.time_to_goal_s)
         ms = sorted(1e3 * t for t in times) or [math.nan]

@@ -101,30 +101,6 @@ def lower_bound(sc: Any) -> float:
     return math.sqrt(2.0 * d / r.a_max)
 
 
-def robot_caused(res: Any, sc: Any) -> bool:
-    """At first contact, does the robot move towards the obstacle faster than 0.05 m/s?"""
-    if not res.collision:
-        return False
-    if "collision_robot_caused" in res.to_dict():
-        return bool(res.to_dict()["collision_robot_caused"])
-    tr = res.trajectory_array
-    k = int(np.argmin(np.abs(tr[:, 0] - res.collision_time_s)))
-    t, x, y, th, v, _ = tr[max(k - 1, 0)]
-    names = {o.name: o for o in sc.moving_obstacles}
-    if res.collision_with in names:
-        q = names[res.collision_with].motion.position(float(t))
-    else:
-        st = {o.name: o for o in sc.static_obstacles}.get(res.collision_with)
-        if st is None:
-            return abs(v) > 0.05
-        q = np.asarray(st.shape.nearest_point((x, y))) if hasattr(st.shape, "nearest_point") else None
-        if q is None:
-            return abs(v) > 0.05
-    d = np.asarray(q, dtype=float) - (x, y)
-    n = float(np.hypot(*d))
-    return bool(n <= 1e-12 or v * (math.cos(th) * d[0] + math.sin(th) * d[1]) / n > 0.05)
-
-
 def run_one(job: tuple[str, int, str, int, dict[str, Any]]) -> dict[str, Any]:
     """One simulated run (top level so that worker processes can call it)."""
     from anyplan.agents import make_agent
@@ -141,7 +117,8 @@ def run_one(job: tuple[str, int, str, int, dict[str, Any]]) -> dict[str, Any]:
     lb = d.get("time_lower_bound_s") or lower_bound(sc)
     improving = improvement_calls(res.extra, len(res.planning_times_s))
     return {"suite": suite, "scenario": sc.name, "planner": planner, "seed": seed,
-            "status": res.status, "collision": res.collision, "robot_caused": robot_caused(res, sc),
+            "status": res.status, "collision": res.collision,
+            "robot_caused": bool(res.collision_robot_caused),
             "time_to_goal": res.time_to_goal_s, "lower_bound": lb, "length": res.path_length_m,
             "plan_times": list(res.planning_times_s), "improving": improving,
             "min_dist": d.get("min_distance_to_moving_m"),
