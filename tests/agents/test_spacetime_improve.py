@@ -54,8 +54,20 @@ def test_improvement_calls_take_up_the_chain_and_only_ever_arrive_earlier(world,
 
         def traced(*a, **kw):
             chains.append((reason, list(kw.get("chain", ()))))
+            stopped = []
+            ask = kw.get("stop")
+
+            def stop(squares):
+                out = ask(squares)
+                if out:
+                    stopped.append(list(squares))
+                return out
+
+            kw["stop"] = None if ask is None else stop
             res = loop_replan(*a, **kw)
-            chains.append(("result", list(res.virtual_obstacles)))
+            # where the loop left off: the squares of the path it ended on, or, stopped by
+            # the budget before a search, the squares that search would have had
+            chains.append(("result", stopped[-1] if stopped else list(res.virtual_obstacles)))
             return res
 
         self.loop.replan = traced
@@ -74,7 +86,7 @@ def test_improvement_calls_take_up_the_chain_and_only_ever_arrive_earlier(world,
     assert without.record.reasons.count(st.IMPROVE) == 0
     reasons = agent.record.reasons
     assert reasons[0] == "initial" and st.IMPROVE in reasons
-    # each improvement call starts from the squares of the path the previous call left off
+    # each improvement call starts from the squares where the previous call left off
     calls = [c for c in chains if c[0] != "result"]
     results = [c for c in chains if c[0] == "result"]
     for k, (reason, chain) in enumerate(calls):

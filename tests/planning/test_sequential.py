@@ -103,6 +103,32 @@ def test_a_chain_left_off_is_taken_up_where_it_stopped():
     assert len(res.costs) == 1  # max_iterations counted from an empty chain
 
 
+def test_stop_ends_the_loop_before_a_search_with_the_squares_so_far():
+    # paper-3 (batches: deterministic) needs at least three plans. A caller that stops before
+    # the second search gets the first plan's best effort, and is asked once, with the first
+    # square; one that never stops gets what no stop gives.
+    sc = load_scenario("paper-3")
+    start, goal = np.array(sc.robot.start[:2]), np.array(sc.robot.goal)
+    cfg = SequentialConfig(prediction_dt=None, batches_per_plan=2)
+    loop, preds, _ = _loop(sc, cfg)
+    full = loop.replan(start, goal, preds, 0.0)
+    asked = []
+
+    def stop(squares):
+        asked.append(list(squares))
+        return True
+
+    loop, preds, _ = _loop(sc, cfg)
+    res = loop.replan(start, goal, preds, 0.0, stop=stop)
+    assert res.status == "collision_predicted" and res.iterations == len(res.costs) == 1
+    assert len(asked) == 1 and len(asked[0]) == 1
+    assert asked[0][0].center == full.virtual_obstacles[0].center
+    assert res.collision is not None and res.costs[0] == full.costs[0]  # the same first plan
+    loop, preds, _ = _loop(sc, cfg)
+    never = loop.replan(start, goal, preds, 0.0, stop=lambda squares: False)
+    assert never.iterations == full.iterations and np.array_equal(never.path, full.path)
+
+
 def test_shrink_square_keeps_the_robot_clear():
     rng = np.random.default_rng(1)
     for _ in range(500):

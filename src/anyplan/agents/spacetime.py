@@ -76,9 +76,9 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             last path (with uncertain predictions, the first and the last) is timed again with
             waits up to this, and the earlier arrival wins.
         search_budget_s: Anytime bound of the search for detours [s] (wall clock): once a path
-            is timed, a detour is timed only if it can end within this much of the
-            replanning's start (the last path's cost standing for its cost), else the best
-            candidate is taken; each replanning times at least one path (with certain
+            is timed, a detour is searched and timed only if it can end within this much of
+            the replanning's start (the last search and timing's cost standing for its cost),
+            else the best candidate is taken; each replanning times at least one path (with certain
             predictions; None: no budget, as the deterministic settings have it). Without a
             timed path the loop runs on.
         improve_calls: With announced motions, when the motion taken arrives more than
@@ -201,7 +201,11 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         self.twist_check_period_s = (None if twist_check_period_s is None
                                      else float(twist_check_period_s))
         self._search_deadline: float | None = None
+        self._call_start = 0.0  # wall clock [s] at the start of this replanning's search
         self._last_build: float | None = None  # wall clock [s] of the last path built
+        #: wall clock [s] of the last search and build (the budget's estimate of the next)
+        self._last_cycle: float | None = None
+        self._stopped_at: list[Any] | None = None  # the squares where the budget stopped the loop
         if not (isinstance(improve_calls, int) and improve_calls >= 0):
             raise ValueError(f"improve_calls: must be an integer >= 0, got {improve_calls!r}")
         self.improve_calls = improve_calls
@@ -269,6 +273,8 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             now, last = time.perf_counter(), self._last_build
             if delay == 0.0:
                 self._last_build = now
+                if last is not None:
+                    self._last_cycle = now - last
             # anytime: a detour is timed only if it can end within the budget, the last
             # path's cost (its BIT* search, smoothing, timing) taken as its cost
             # (and at least one path per replanning: an improving one makes progress)
@@ -336,6 +342,24 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
 
         return build
 
+    def _out_of_budget(self, squares: Sequence[Any]) -> bool:
+        """Before a detour search (the loop's ``stop``): True, and the loop stops, when a path
+        is timed already and another search and build, costing what the last one did (or the
+        call so far, after its first), would end after the budget; the same anytime rule as
+        :meth:`_timed_fn`'s, applied before the search instead of after it. The squares are
+        kept: an improvement call goes on from them."""
+        deadline, last = self._search_deadline, self._last_build
+        if deadline is None or last is None or not self._cands:
+            return False
+        now = time.perf_counter()
+        cost = self._last_cycle if self._last_cycle is not None else now - self._call_start
+        if now + cost <= deadline:
+            return False
+        self.record.st_pruned += 1
+        self._cut = True
+        self._stopped_at = list(squares)
+        return True
+
     def _is_candidate(self, motion: object) -> bool:
         """True for a timed candidate of this replanning (checked free when it was timed)."""
         return any(c[1] is motion for c in self._cands)
@@ -376,10 +400,10 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         self._tried = []
         self._preds = list(preds)
         self._nominals = {}
-        w0 = time.perf_counter()
+        w0 = self._call_start = time.perf_counter()
         budget = self.search_budget_s if inc is None else self.improve_budget_s
         self._search_deadline = None if budget is None else w0 + budget
-        self._last_build = None
+        self._last_build = self._last_cycle = self._stopped_at = None
         res: SequentialResult | None = None
         if inc is None and self._path is not None and len(self._path) >= 2:
             # First the path in use, from where the robot will be: no new search if it can be
@@ -408,8 +432,10 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
                                                   first_wait_s=self.max_wait_s if long_bound
                                                   else None),
                                    chain=self._chain if inc is not None else (),
-                                   verified=self._is_candidate)
-        self._chain = list(res.virtual_obstacles) if self._cut else []
+                                   verified=self._is_candidate,
+                                   stop=self._out_of_budget if long_bound else None)
+        self._chain = ([] if not self._cut else list(res.virtual_obstacles)
+                       if self._stopped_at is None else self._stopped_at)
         if not self._cands and self._tried and long_ok:
             # No timing at all: allow long waits on the shortest path (unless the loop gave it
             # them already) and on the last detour.

@@ -284,7 +284,8 @@ class SequentialBITStar:
     def replan(self, start: np.ndarray, goal: np.ndarray, predictions: Sequence[PredictedObstacle],
                t_now: float, motion: MotionModel | None = None,
                chain: Sequence[VirtualObstacle] = (),
-               verified: Callable[[TimedMotion], bool] | None = None) -> SequentialResult:
+               verified: Callable[[TimedMotion], bool] | None = None,
+               stop: Callable[[Sequence[VirtualObstacle]], bool] | None = None) -> SequentialResult:
         """Plan from ``start`` to ``goal`` until the predicted motion is collision-free.
 
         Args:
@@ -298,6 +299,9 @@ class SequentialBITStar:
                 is no longer clear of them.
             verified: True for a motion of ``motion`` that the model itself has checked free
                 of the predictions: the loop takes it without checking it again.
+            stop: Asked before each search after this replanning's first, with the squares it
+                would search among: True ends the iterations there, as ``max_time_s`` does
+                (an anytime caller's budget, spent before a search rather than after it).
         """
         motion_fn = motion or self.motion
         if motion_fn is None:
@@ -327,7 +331,7 @@ class SequentialBITStar:
         deadline = time.perf_counter() + cfg.max_time_s
         for it in range(first_it, max(cfg.max_iterations, first_it + 1)):
             t0 = time.perf_counter()
-            if it > first_it and t0 > deadline:
+            if it > first_it and (t0 > deadline or (stop is not None and stop(squares))):
                 break
             if not cfg.warm_start and it > 0:
                 planner = BITStar(problem.with_shapes([s.shape for s in squares]), cfg.bitstar,
