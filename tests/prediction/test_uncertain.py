@@ -31,6 +31,22 @@ def test_radius_growth_is_monotone_capped_and_its_rate_bounds_the_slope():
     assert g.rate == pytest.approx(0.6)
 
 
+def test_growths_built_row_by_row_at_once_equal_the_growths_built_one_by_one():
+    rng = np.random.default_rng(3)
+    taus = np.array([0.0, 0.5, 1.0, 2.0, 4.0])
+    values = rng.normal(0.3, 0.4, (6, len(taus)))  # negative and decreasing entries too
+    t0 = list(rng.uniform(0.0, 10.0, 6))
+    for g, t, row in zip(RadiusGrowth.rows(t0, taus, values), t0, values, strict=True):
+        one = RadiusGrowth(t, taus, row)
+        assert g.t0 == one.t0 and g.rate == one.rate and g.max_extra == one.max_extra
+        assert np.array_equal(g.taus, one.taus) and np.array_equal(g.values, one.values)
+    assert RadiusGrowth.rows([], taus, np.zeros((0, len(taus)))) == []
+    with pytest.raises(ValueError, match="increasing"):
+        RadiusGrowth.rows([0.0], taus[::-1], values[:1])
+    with pytest.raises(ValueError, match="as long as"):
+        RadiusGrowth.rows([0.0, 1.0], taus, values[:1])
+
+
 def test_uncertainty_grows_with_the_horizon_and_with_occlusion():
     tr = Tracker(TrackerConfig(sigma_m=0.05))
     rng = np.random.default_rng(0)

@@ -40,6 +40,30 @@ class RadiusGrowth:
         rate = 0.0 if len(k) < 2 else float(max(np.max(np.diff(v) / np.diff(k)), 0.0))
         object.__setattr__(self, "_rate", rate)  # asked for in every contact search
 
+    @classmethod
+    def rows(cls, t0: Sequence[float], taus: np.ndarray, values: np.ndarray) -> list[RadiusGrowth]:
+        """One growth per row of ``values`` (n, len(taus)) [m], from ``t0[i]`` [s] on, on the
+        shared knots ``taus`` [s]: the same objects as ``RadiusGrowth(t0[i], taus,
+        values[i])`` one by one, checked and normalised for all rows at once (a tracker builds
+        one per obstacle at every detection)."""
+        k = np.asarray(taus, dtype=float)
+        v = np.asarray(values, dtype=float)
+        if (k.ndim != 1 or len(k) < 1 or v.ndim != 2 or v.shape[1] != len(k)
+                or len(t0) != len(v) or np.any(np.diff(k) <= 0.0)):
+            raise ValueError("taus must be increasing and as long as each row of values")
+        v = np.maximum.accumulate(np.maximum(v, 0.0), axis=1)
+        rates = (np.zeros(len(v)) if len(k) < 2
+                 else np.maximum(np.max(np.diff(v, axis=1) / np.diff(k), axis=1), 0.0))
+        out = []
+        for t, row, rate in zip(t0, v, rates, strict=True):
+            g = object.__new__(cls)
+            object.__setattr__(g, "t0", t)
+            object.__setattr__(g, "taus", k)
+            object.__setattr__(g, "values", row)
+            object.__setattr__(g, "_rate", float(rate))
+            out.append(g)
+        return out
+
     def at(self, t: np.ndarray | float) -> np.ndarray:
         """Extra radius [m] at absolute times ``t`` [s]."""
         return np.interp(np.asarray(t, dtype=float) - self.t0, self.taus, self.values)

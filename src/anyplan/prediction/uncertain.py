@@ -86,12 +86,10 @@ class UncertaintyModel:
         ex = self.extras(estimates)
         taus = np.asarray(self.taus, dtype=float)
         means = self._means(estimates)
-        out = []
-        for e, x, row in zip(estimates, means, ex, strict=True):
-            out.append(ObstacleObservation(e.name, e.t, float(x[0]), float(x[1]), e.heading,
-                                           e.speed, float(x[4]), e.radius, None,
-                                           RadiusGrowth(e.t, taus, row)))
-        return tuple(out)
+        growths = RadiusGrowth.rows([e.t for e in estimates], taus, ex)
+        return tuple(ObstacleObservation(e.name, e.t, float(x[0]), float(x[1]), e.heading, e.speed,
+                                         float(x[4]), e.radius, None, g)
+                     for e, x, g in zip(estimates, means, growths, strict=True))
 
 
 #: The model's settings by name: its scalar fields (the horizon knots ``taus`` are its shape,
