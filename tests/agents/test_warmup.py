@@ -35,7 +35,7 @@ def test_unknown_part_is_refused():
 
 def test_agents_declare_only_the_parts_they_use():
     assert make_agent("st-bitstar").kernel_parts == PARTS
-    assert make_agent("seq-bitstar").kernel_parts == ("bitstar", "motion", "sequential")
+    assert make_agent("seq-bitstar").kernel_parts == ("bitstar", "motion", "contacts", "sequential")
     assert make_agent("bitstar").kernel_parts == ("bitstar", "motion")
     assert not getattr(make_agent("dovs"), "kernel_parts", ())
 
@@ -112,11 +112,11 @@ def no_parts_loaded(monkeypatch):
 
 def test_second_process_takes_the_motion_part_only_when_another_part_stays_here(no_parts_loaded):
     wu = no_parts_loaded
-    assert wu.prefetch_parts(PARTS) == ("motion",)
+    assert wu.prefetch_parts(PARTS) == ("motion", "contacts")
     assert wu.prefetch_parts(("bitstar", "motion")) == ("motion",)
-    assert wu.prefetch_parts(("motion",)) == ()  # this process would only wait
+    assert wu.prefetch_parts(("motion", "contacts")) == ()  # this process would only wait
     assert wu.prefetch_parts(("bitstar",)) == ()
-    wu._DONE.add("motion")
+    wu._DONE.update(("motion", "contacts"))
     assert wu.prefetch_parts(PARTS) == ()  # already loaded here
 
 

@@ -389,3 +389,87 @@ def test_growth_of_many_discs_at_once_matches_each_disc():
         want = np.array([np.zeros_like(t) if o.growth is None else o.growth.at(t) for o in obs])
         assert np.allclose(got, want, rtol=0.0, atol=1e-12)
         assert np.all(got[2] == 0.0)
+
+
+class _AtRest:
+    """A robot reference standing at ``p`` [m] over [0, t_end] [s]."""
+
+    def __init__(self, p, t_end):
+        self.p, self.t_start, self.t_end, self.max_speed = np.asarray(p, float), 0.0, t_end, 0.0
+
+    def positions(self, t):
+        return np.tile(self.p, (len(np.atleast_1d(t)), 1))
+
+
+@pytest.mark.parametrize("sd", [0.02, 0.05])
+def test_straight_discs_meet_a_robot_at_rest_at_the_closed_form_time(sd):
+    # An obstacle 6 m away comes straight at the robot at 0.5 m/s, its disc growing at
+    # 0.25 m/s for 4 s then capped; a second one waits 2 s, then comes at 1 m/s; a third passes
+    # 1.5 m wide; a fourth would come but its prediction ends first.
+    from anyplan.prediction.base import RadiusGrowth
+
+    robot = _AtRest((0.0, 0.0), 12.0)
+    grow = RadiusGrowth(0.0, np.array([0.0, 4.0]), np.array([0.0, 1.0]))
+    obs = [PredictedObstacle("a", 0.3, UnicycleMotion(6.0, 0.0, np.pi, 0.5), grow),
+           PredictedObstacle("b", 0.3, UnicycleMotion(0.0, 5.0, -np.pi / 2, 1.0, 0.0, 2.0), grow),
+           PredictedObstacle("c", 0.3, UnicycleMotion(-5.0, 1.5, 0.0, 1.0)),
+           PredictedObstacle("d", 0.3, UnicycleMotion(0.0, -3.0, np.pi / 2, 1.0), until=1.0)]
+    hits = {h.obstacle: h for h in predict_collisions(robot, obs, 0.3, sample_dt=sd)}
+    assert set(hits) == {"a", "b"}
+    # a: 6 - 0.5 t = 0.6 + 0.25 t before the cap -> t = 7.2 (> 4: capped) -> 6 - 0.5 t = 1.6
+    assert hits["a"].t == pytest.approx(8.8, abs=1e-9)
+    # b: at rest until 2 s; then 5 - (t - 2) = 0.6 + 0.25 t -> t = 5.12 (> 4) -> 7 - t = 1.6
+    assert hits["b"].t == pytest.approx(5.4, abs=1e-9)
+    assert hits["b"].obstacle_radius == pytest.approx(1.3, abs=1e-9)
+    # the same with the growth's cap 2 s later: the contact before it, on the slope
+    late = RadiusGrowth(0.0, np.array([0.0, 6.0]), np.array([0.0, 1.5]))
+    hit = first_collision(robot, [PredictedObstacle("b", 0.3, obs[1].motion, late)], 0.3, sample_dt=sd)
+    assert hit.t == pytest.approx(6.4 / 1.25, abs=1e-9)
+    first = first_collision(robot, obs, 0.3, sample_dt=sd)
+    assert first.obstacle == "b" and first.t == hits["b"].t
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_straight_discs_in_closed_form_agree_with_the_certified_search(seed):
+    # Straight discs, with and without growth, with horizons, some starting later: the closed
+    # form on the robot's samples finds the contacts the certified search on the same samples
+    # finds, never earlier than it (it reports the start of the first interval it cannot
+    # certify free), at a time where the gap is zero and before which it is nowhere negative.
+    from anyplan.prediction import collision
+    from anyplan.prediction.base import RadiusGrowth
+
+    rng = np.random.default_rng(seed)
+    grows = [None, RadiusGrowth(0.3, np.array([0.0, 1.0, 3.0]), np.array([0.05, 0.4, 0.9]))]
+    obs = []
+    for i in range(40):
+        x0, y0, th, v = rng.uniform((0, 0, -np.pi, 0.0), (15, 11, np.pi, 1.5))
+        m = UnicycleMotion(x0, y0, th, v, 0.0, float(rng.choice([0.0, rng.uniform(0, 5)])))
+        until = float(rng.choice([np.inf, rng.uniform(1, 8)]))
+        obs.append(PredictedObstacle(f"o{i}", float(rng.uniform(0.2, 0.5)), m, grows[i % 2], until))
+    tol, found = 1e-4, 0
+    for m in MOTIONS.values():
+        for sd in (0.02, 0.05):
+            collision._MEMO.clear()
+            new = {h.obstacle: h for h in predict_collisions(m, obs, 0.3, margin=0.05, sample_dt=sd)}
+            old = {h.obstacle: h for h in collision._certified_hits(
+                m, obs, 0.3, m.t_start, m.t_end, 0.05, tol, sd, False)}
+            assert set(new) == set(old)
+            sm = SampledMotion(m, m.t_start, m.t_end, sd)
+            for name, h in new.items():
+                assert old[name].t - 1e-9 <= h.t
+                np.testing.assert_allclose(h.robot_position, m.positions(np.array([h.t]))[0])
+                o = next(o for o in obs if o.name == name)
+                reach = 0.3 + 0.05 + sm.error_bound + o.radius
+
+                def gap(t, o=o, reach=reach, sm=sm):
+                    d = np.hypot(*(sm.positions(t) - o.positions(t)).T)
+                    return d - reach - (0.0 if o.growth is None else o.growth.at(t))
+
+                assert gap(np.array([h.t]))[0] <= 1e-9
+                assert h.t == m.t_start or gap(np.array([h.t]))[0] >= -1e-9
+                before = np.arange(m.t_start, h.t, 1e-3)
+                assert np.all(gap(before) > -1e-9)
+            found += len(new)
+            first = first_collision(m, obs, 0.3, margin=0.05, sample_dt=sd)
+            assert first is not None and first.t == min(h.t for h in new.values())
+    assert found >= 10

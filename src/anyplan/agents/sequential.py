@@ -56,7 +56,7 @@ class SequentialBITStarAgent(ReplanningAgent):
 
     name = "seq-bitstar"
     #: Kernel parts this agent uses (:func:`~anyplan.agents.warmup.warm_up_kernels`).
-    kernel_parts: tuple[str, ...] = ("bitstar", "motion", "sequential")
+    kernel_parts: tuple[str, ...] = ("bitstar", "motion", "contacts", "sequential")
     config_classes: tuple[Any, ...] = (SequentialConfig,)
     #: A fixed simulated planning delay [s], a batch budget instead of a time budget, and a
     #: wall-clock cap far above any planning time: the run no longer depends on the machine.

@@ -134,7 +134,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
     """
 
     name = "st-bitstar"
-    kernel_parts = ("bitstar", "stmap", "motion", "sequential", "spacetime")
+    kernel_parts = ("bitstar", "stmap", "motion", "contacts", "sequential", "spacetime")
     #: Search the loop's candidate paths by branch and bound (:meth:`_timed_fn`) when the
     #: predictions are certain; False times every path of the loop within ``patience_s``.
     branch_and_bound = True

@@ -33,12 +33,12 @@ __all__ = ["warm_up_kernels", "PARTS", "compiling_notifier", "prefetch_kernels",
 
 logger = logging.getLogger(__name__)
 #: Every part, in the order they are loaded.
-PARTS = ("bitstar", "stmap", "motion", "sequential", "spacetime")
+PARTS = ("bitstar", "stmap", "motion", "contacts", "sequential", "spacetime")
 _DONE: set[str] = set()
 #: A part that a second process may compile while this one compiles the others: it shares no
 #: kernel with loading a scenario, the time lower bound or BIT*'s part (``sequential`` runs
 #: BIT* and the motion planner, so it would compile both again).
-PREFETCHABLE = ("motion",)
+PREFETCHABLE = ("motion", "contacts")
 #: Set to ``1`` (or ``0``) to compile in this process only.
 ENV_JOBS = "ANYPLAN_COMPILE_JOBS"
 
@@ -235,6 +235,27 @@ def _motion() -> None:
         traj.sample(np.linspace(0.0, traj.t_end, 7))
 
 
+def _contacts() -> None:
+    """The closed-form first contacts of straight discs, growing or not, with a sampled motion
+    (the collision prediction's common case: twist and tracked predictions, straight movers)."""
+    from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
+    from anyplan.prediction.collision import predict_collisions
+    from anyplan.world.motion import UnicycleMotion
+
+    class _Line:  # a robot reference on a straight line: x = t [m]
+        t_start, t_end, max_speed = 0.0, 4.0, 1.0
+
+        def positions(self, t: np.ndarray) -> np.ndarray:
+            t = np.asarray(t, dtype=float)
+            return np.column_stack([t, np.zeros_like(t)])
+
+    grow = RadiusGrowth(0.0, np.array([0.0, 2.0]), np.array([0.0, 0.5]))
+    movers = [PredictedObstacle("a", 0.2, UnicycleMotion(3.0, 1.0, -1.5708, 0.5), grow),
+              PredictedObstacle("b", 0.2, UnicycleMotion(1.0, -2.0, 1.5708, 0.5))]
+    predict_collisions(_Line(), movers, 0.2, sample_dt=0.02)
+    predict_collisions(_Line(), movers[1:], 0.2, sample_dt=0.02)
+
+
 def _sequential() -> None:
     """Collision prediction, and one Sequential BIT* replanning around a crossing obstacle."""
     from anyplan.planning.sequential import SequentialBITStar, SequentialConfig
@@ -313,8 +334,8 @@ def _spacetime() -> None:
         verify(res.trajectory, [mover], spec.radius)
 
 
-_RUN = {"bitstar": _bitstar, "stmap": _stmap, "motion": _motion, "sequential": _sequential,
-        "spacetime": _spacetime}
+_RUN = {"bitstar": _bitstar, "stmap": _stmap, "motion": _motion, "contacts": _contacts,
+        "sequential": _sequential, "spacetime": _spacetime}
 
 
 def warm_up_kernels(parts: Iterable[str] = PARTS,

@@ -9,8 +9,10 @@ speed so that no contact can slip between evaluation points: the time returned i
 ``tol`` and never later than the true first contact. An obstacle whose radius grows with the
 horizon (``PredictedObstacle.growth``, an uncertain prediction) is searched with its growing
 radius and the growth rate added to the speed bound
-(:func:`anyplan.geometry.moving.first_contact_growing`): exact for the growing disc too. A
-prediction with a horizon (``PredictedObstacle.until``) is checked up to it only.
+(:func:`anyplan.geometry.moving.first_contact_growing`): exact for the growing disc too. On a
+resampled motion, a disc on a straight line needs no search: its first contact is a
+quadratic's first root (:mod:`anyplan.prediction._contact_kernels`). A prediction with a
+horizon (``PredictedObstacle.until``) is checked up to it only.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from anyplan.geometry.moving import first_contact, first_contact_growing
+from anyplan.prediction._contact_kernels import StraightDiscs
 from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
 from anyplan.world.motion import TrackMotion, UnicycleMotion, WaypointMotion
 
@@ -185,13 +188,64 @@ def _predict(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], robot_
 def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle],
                       robot_radius: float, t0: float, t1: float, margin: float, tol: float,
                       sample_dt: float | None, first_only: bool) -> list[PredictedCollision]:
+    """The discs on straight lines (the ``twist`` and ``tracked`` predictions) in closed form
+    on the robot's samples (:func:`_straight_hits`), the others by the certified search
+    (:func:`_certified_hits`); merged, earliest first."""
+    if t1 < t0 or not obstacles:
+        return []
+    if sample_dt is None:
+        return _certified_hits(motion, obstacles, robot_radius, t0, t1, margin, tol, None,
+                               first_only)
+    lines = _by_identity(_LINES, obstacles, lambda: StraightDiscs.of(obstacles))
+    if not len(lines.index):
+        return _certified_hits(motion, obstacles, robot_radius, t0, t1, margin, tol, sample_dt,
+                               first_only)
+    sampled = SampledMotion(motion, t0, t1, sample_dt)
+    out = _straight_hits(motion, sampled, obstacles, lines, robot_radius + margin, t0, t1,
+                         first_only)
+    if lines.rest:  # each obstacle's contact is its own: the same answer with or without the others
+        rest = [obstacles[k] for k in lines.rest]
+        out += _certified_hits(motion, rest, robot_radius, t0, t1, margin, tol, sample_dt,
+                               first_only, sampled)
+    out.sort(key=lambda c: c.t)
+    return out[:1] if first_only else out
+
+
+#: Recent :class:`StraightDiscs` records, by the identity of their prediction sets.
+_LINES: dict[tuple[int, ...], tuple[tuple[object, ...], Any]] = {}
+
+
+def _straight_hits(motion: TimedMotion, sampled: SampledMotion,
+                   obstacles: Sequence[PredictedObstacle], lines: StraightDiscs, reach0: float,
+                   t0: float, t1: float, first_only: bool) -> list[PredictedCollision]:
+    """First contacts with the obstacles ``lines`` (straight, shared growth knots), exact on the
+    robot's samples with the contact distance enlarged by their error bound (so never later
+    than the true motion's), by :meth:`StraightDiscs.first_contacts`."""
+    times = lines.first_contacts(sampled._t, sampled._x, sampled._y,
+                                 reach0 + sampled.error_bound, t0, min(t1, sampled.t_end),
+                                 first_only)
+    out = []
+    for j in np.flatnonzero(times < math.inf):
+        o, tc = obstacles[int(lines.index[j])], float(times[j])
+        ta = np.array([tc])
+        out.append(PredictedCollision(o.name, tc, motion.positions(ta)[0], o.positions(ta)[0],
+                                      float(o.radius_at(tc))))
+    return out
+
+
+def _certified_hits(motion: TimedMotion, obstacles: Sequence[PredictedObstacle],
+                    robot_radius: float, t0: float, t1: float, margin: float, tol: float,
+                    sample_dt: float | None, first_only: bool,
+                    sampled: SampledMotion | None = None) -> list[PredictedCollision]:
+    """The certified search for any predicted motion (``sampled``: the robot's samples, if
+    already made)."""
     out: list[PredictedCollision] = []
     if t1 < t0 or not obstacles:
         return out
     extra = 0.0
     true_motion = motion  # the contact's robot position is the motion's, not the samples'
     if sample_dt is not None:
-        motion = SampledMotion(motion, t0, t1, sample_dt)
+        motion = sampled if sampled is not None else SampledMotion(motion, t0, t1, sample_dt)
         extra = motion.error_bound
         grid = motion._t
     else:
