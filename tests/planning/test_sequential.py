@@ -69,16 +69,22 @@ def test_squares_are_centred_on_the_robot_reference_at_the_collision():
     assert v.collision_time_s > 0.0
 
 
+def _paper3_on_batches():
+    """paper-3 with BIT* on batches (deterministic): the scenario, start, goal, loop settings and
+    the loop's whole replanning from the start."""
+    sc = load_scenario("paper-3")
+    start, goal = np.array(sc.robot.start[:2]), np.array(sc.robot.goal)
+    cfg = SequentialConfig(prediction_dt=None, batches_per_plan=2)
+    loop, preds, _ = _loop(sc, cfg)
+    return sc, start, goal, cfg, loop.replan(start, goal, preds, 0.0)
+
+
 def test_a_chain_left_off_is_taken_up_where_it_stopped():
     # paper-3 (BIT* on batches: deterministic): the loop goes around three squares. Started
     # again from the first square of its chain, it plans around that square from its first
     # path on (the straight line is not tried again), counts it towards max_iterations, and
     # ends free as well.
-    sc = load_scenario("paper-3")
-    start, goal = np.array(sc.robot.start[:2]), np.array(sc.robot.goal)
-    cfg = SequentialConfig(prediction_dt=None, batches_per_plan=2)
-    loop, preds, _ = _loop(sc, cfg)
-    full = loop.replan(start, goal, preds, 0.0)
+    sc, start, goal, cfg, full = _paper3_on_batches()
     assert full.collision_free and len(full.virtual_obstacles) >= 2
     first = full.virtual_obstacles[:1]
     loop, preds, _ = _loop(sc, cfg)
@@ -107,11 +113,7 @@ def test_stop_ends_the_loop_before_a_search_with_the_squares_so_far():
     # paper-3 (batches: deterministic) needs at least three plans. A caller that stops before
     # the second search gets the first plan's best effort, and is asked once, with the first
     # square; one that never stops gets what no stop gives.
-    sc = load_scenario("paper-3")
-    start, goal = np.array(sc.robot.start[:2]), np.array(sc.robot.goal)
-    cfg = SequentialConfig(prediction_dt=None, batches_per_plan=2)
-    loop, preds, _ = _loop(sc, cfg)
-    full = loop.replan(start, goal, preds, 0.0)
+    sc, start, goal, cfg, full = _paper3_on_batches()
     asked = []
 
     def stop(squares):
