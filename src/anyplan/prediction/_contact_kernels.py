@@ -102,8 +102,7 @@ def straight_contacts(ts: np.ndarray, xs: np.ndarray, ys: np.ndarray, t0: float,
             grown = max(grown, g_vals[k, j])
         if gx * gx + gy * gy > (reach[k] + CONTACT_EPS + grown) ** 2:
             continue  # farther than its largest disc at every time: no contact
-        i = np.searchsorted(ts, t0, side="right") - 1
-        i = min(max(i, 0), n - 2)
+        i = min(max(int(np.searchsorted(ts, t0, side="right")) - 1, 0), n - 2)
         a = t0
         found = False
         while not found and a <= t_end:
