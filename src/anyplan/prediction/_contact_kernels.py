@@ -194,7 +194,6 @@ class StraightDiscs:
                    np.array([obstacles[k].until for k in index], dtype=float),
                    np.array([0.0 if g is None else g.t0 for g in gs], dtype=float), taus, vals)
 
-
     def first_contacts(self, ts: np.ndarray, xs: np.ndarray, ys: np.ndarray, reach0: float,
                        t0: float, t1: float, first_only: bool) -> np.ndarray:
         """First contact time [s] in [t0, t1] of the robot's samples (``ts``, ``xs``, ``ys``)
