@@ -434,8 +434,12 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
                                    chain=self._chain if inc is not None else (),
                                    verified=self._is_candidate,
                                    stop=self._out_of_budget if long_bound else None)
-        self._chain = ([] if not self._cut else list(res.virtual_obstacles)
-                       if self._stopped_at is None else self._stopped_at)
+        # an improvement call goes on where the budget cut this one: before a search (the
+        # squares it would have searched among) or before a timing (the path's squares)
+        self._chain = []
+        if self._cut:
+            self._chain = (self._stopped_at if self._stopped_at is not None
+                           else list(res.virtual_obstacles))
         if not self._cands and self._tried and long_ok:
             # No timing at all: allow long waits on the shortest path (unless the loop gave it
             # them already) and on the last detour.

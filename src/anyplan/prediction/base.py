@@ -15,6 +15,18 @@ __all__ = ["ObstacleObservation", "PredictedObstacle", "Predictor", "ConstantTwi
            "RadiusGrowth"]
 
 
+def _normalised(taus: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Knots [s] checked (increasing, as many as each row of ``values`` (n, K) [m]), the rows
+    made nonnegative and nondecreasing, and each row's largest slope [m/s] (0 with one knot)."""
+    k = np.asarray(taus, dtype=float)
+    if k.ndim != 1 or len(k) < 1 or values.shape[1] != len(k) or np.any(np.diff(k) <= 0.0):
+        raise ValueError("taus must be increasing and as long as values")
+    v = np.maximum.accumulate(np.maximum(values, 0.0), axis=1)
+    rates = (np.zeros(len(v)) if len(k) < 2
+             else np.maximum(np.max(np.diff(v, axis=1) / np.diff(k), axis=1), 0.0))
+    return k, v, rates
+
+
 @dataclass(frozen=True)
 class RadiusGrowth:
     """Extra radius [m] of an uncertain prediction as a function of the horizon.
@@ -31,14 +43,12 @@ class RadiusGrowth:
     _rate: float = field(init=False, repr=False, compare=False, default=0.0)
 
     def __post_init__(self) -> None:
-        k = np.asarray(self.taus, dtype=float)
-        v = np.maximum.accumulate(np.maximum(np.asarray(self.values, dtype=float), 0.0))
-        if k.ndim != 1 or len(k) != len(v) or len(k) < 1 or np.any(np.diff(k) <= 0.0):
+        if np.ndim(self.values) != 1:
             raise ValueError("taus must be increasing and as long as values")
+        k, v, rates = _normalised(self.taus, np.asarray(self.values, dtype=float)[None, :])
         object.__setattr__(self, "taus", k)
-        object.__setattr__(self, "values", v)
-        rate = 0.0 if len(k) < 2 else float(max(np.max(np.diff(v) / np.diff(k)), 0.0))
-        object.__setattr__(self, "_rate", rate)  # asked for in every contact search
+        object.__setattr__(self, "values", v[0])
+        object.__setattr__(self, "_rate", float(rates[0]))  # asked for in every contact search
 
     @classmethod
     def rows(cls, t0: Sequence[float], taus: np.ndarray, values: np.ndarray) -> list[RadiusGrowth]:
@@ -46,14 +56,10 @@ class RadiusGrowth:
         shared knots ``taus`` [s]: the same objects as ``RadiusGrowth(t0[i], taus,
         values[i])`` one by one, checked and normalised for all rows at once (a tracker builds
         one per obstacle at every detection)."""
-        k = np.asarray(taus, dtype=float)
         v = np.asarray(values, dtype=float)
-        if (k.ndim != 1 or len(k) < 1 or v.ndim != 2 or v.shape[1] != len(k)
-                or len(t0) != len(v) or np.any(np.diff(k) <= 0.0)):
-            raise ValueError("taus must be increasing and as long as each row of values")
-        v = np.maximum.accumulate(np.maximum(v, 0.0), axis=1)
-        rates = (np.zeros(len(v)) if len(k) < 2
-                 else np.maximum(np.max(np.diff(v, axis=1) / np.diff(k), axis=1), 0.0))
+        if v.ndim != 2 or len(t0) != len(v):
+            raise ValueError("taus must be increasing and as long as values, one row per t0")
+        k, v, rates = _normalised(taus, v)
         out = []
         for t, row, rate in zip(t0, v, rates, strict=True):
             g = object.__new__(cls)
