@@ -507,6 +507,48 @@ def test_a_stoppable_motion_struck_later_gives_way_to_a_free_evasion():
     assert freer_evasion(ranker, 0.0, state, away, away, hold) is None
 
 
+def test_a_stoppable_motion_that_arrives_before_its_contact_is_not_given_up():
+    # The robot is 1.2 m short of its goal (11, 3); a person walks down x = 11 and reaches the
+    # goal about 2 s after the robot could be there. The motion to the goal is stoppable
+    # (struck only at rest, at the goal) and an evasion sideways is free, so the freer-evasion
+    # rule alone would leave the goal; but the run is over on arrival, before that contact:
+    # the guard keeps the motion. Struck before arrival, the evasion is taken as before.
+    from anyplan.agents.base import Observation
+    from anyplan.agents.evasion import freer_evasion
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.prediction.collision import first_collision
+    from anyplan.trajectory.motion import plan_motion
+    from anyplan.world import RobotState, UnicycleMotion
+
+    agent = _agent_in_empty_room(v_max=1.0, omega_max=1.5, a_max=1.0, alpha_max=3.0)
+    state = RobotState(9.8, 3.0, 0.0, 0.0, 0.0)
+    motion = plan_motion(np.array([[9.8, 3.0], [11.0, 3.0]]), agent.spec, state,
+                         agent.obstacles, 0.0)
+    goal = np.asarray(agent.spec.goal)
+    ts = np.linspace(0.0, float(motion.t_end), 400)
+    d = np.hypot(*(motion.positions(ts) - goal).T)
+    t_arrive = float(ts[np.argmax(d <= 0.5 * agent.spec.goal_tolerance)])
+    m = agent.guard.config.margin
+
+    def walker(t_at_goal):
+        y0 = 3.0 + 1.0 * t_at_goal  # 1 m/s southwards, at the goal at t_at_goal
+        return [PredictedObstacle("P", 0.25, UnicycleMotion(11.0, y0, -math.pi / 2, 1.0))]
+
+    late = walker(t_arrive + 2.0)
+    hit = first_collision(motion, late, agent.spec.radius, t_from=0.0, t_until=8.0, margin=m)
+    assert hit is not None and hit.t > t_arrive  # struck at the goal, after arrival
+    assert freer_evasion(agent._ranker(), 0.0, state, late, late, motion) is not None
+    assert agent._arrives_before(motion, 0.0, hit.t)
+    kind, tr = agent._guard(Observation(0.0, state), 0.0, motion, late, late, "test")
+    assert kind == "motion" and tr is motion
+    early = walker(t_arrive - 0.3)  # at the goal just before the robot
+    hit = first_collision(motion, early, agent.spec.radius, t_from=0.0, t_until=8.0, margin=m)
+    assert hit is not None and hit.t < t_arrive
+    assert not agent._arrives_before(motion, 0.0, hit.t)
+    kind, _ = agent._guard(Observation(0.0, state), 0.0, motion, early, early, "test")
+    assert kind != "motion"
+
+
 def test_the_prediction_horizon_covers_a_slow_robots_escape_time():
     # A robot that turns at 0.4 rad/s and drives at 0.4 m/s needs about 9 s to leave an
     # obstacle's way: predictions are extrapolated that long, not 3 s; a fast robot keeps 3 s.
