@@ -507,12 +507,12 @@ def test_a_stoppable_motion_struck_later_gives_way_to_a_free_evasion():
     assert freer_evasion(ranker, 0.0, state, away, away, hold) is None
 
 
-def test_a_stoppable_motion_that_arrives_before_its_contact_is_not_given_up():
+def test_a_motion_is_checked_until_it_arrives_at_the_goal():
     # The robot is 1.2 m short of its goal (11, 3); a person walks down x = 11 and reaches the
-    # goal about 2 s after the robot could be there. The motion to the goal is stoppable
-    # (struck only at rest, at the goal) and an evasion sideways is free, so the freer-evasion
-    # rule alone would leave the goal; but the run is over on arrival, before that contact:
-    # the guard keeps the motion. Struck before arrival, the evasion is taken as before.
+    # goal about 2 s after the robot is there. Checked to its end the motion to the goal is
+    # struck at rest, at the goal, and a sideways evasion is free, so the freer-evasion rule
+    # would leave the goal; but the run is over on arrival: the guard checks the motion until
+    # then, finds it free to rest and starts it. A person there before the robot still counts.
     from anyplan.agents.base import Observation
     from anyplan.agents.evasion import freer_evasion
     from anyplan.prediction import PredictedObstacle
@@ -525,10 +525,15 @@ def test_a_stoppable_motion_that_arrives_before_its_contact_is_not_given_up():
     motion = plan_motion(np.array([[9.8, 3.0], [11.0, 3.0]]), agent.spec, state,
                          agent.obstacles, 0.0)
     goal = np.asarray(agent.spec.goal)
-    ts = np.linspace(0.0, float(motion.t_end), 400)
+    ts = np.linspace(0.0, float(motion.t_end), 2001)
     d = np.hypot(*(motion.positions(ts) - goal).T)
-    t_arrive = float(ts[np.argmax(d <= 0.5 * agent.spec.goal_tolerance)])
-    m = agent.guard.config.margin
+    t_arrive = agent.guard.arrival(motion, 0.0)
+    first_in = float(ts[np.argmax(d <= 0.5 * agent.spec.goal_tolerance)])
+    assert first_in - 1e-9 <= t_arrive <= first_in + 0.02  # on 20 ms samples
+    assert t_arrive < float(motion.t_end)
+    away = plan_motion(np.array([[9.8, 3.0], [9.8, 5.0]]), agent.spec, state, agent.obstacles, 0.0)
+    assert agent.guard.arrival(away, 0.0) == math.inf  # ends elsewhere
+    m, commit = agent.guard.config.margin, agent._period()
 
     def walker(t_at_goal):
         y0 = 3.0 + 1.0 * t_at_goal  # 1 m/s southwards, at the goal at t_at_goal
@@ -538,13 +543,13 @@ def test_a_stoppable_motion_that_arrives_before_its_contact_is_not_given_up():
     hit = first_collision(motion, late, agent.spec.radius, t_from=0.0, t_until=8.0, margin=m)
     assert hit is not None and hit.t > t_arrive  # struck at the goal, after arrival
     assert freer_evasion(agent._ranker(), 0.0, state, late, late, motion) is not None
-    assert agent._arrives_before(motion, 0.0, hit.t)
+    assert agent.guard.check(motion, late, 0.0, commit)[0] == "free_to_rest"
     kind, tr = agent._guard(Observation(0.0, state), 0.0, motion, late, late, "test")
     assert kind == "motion" and tr is motion
     early = walker(t_arrive - 0.3)  # at the goal just before the robot
     hit = first_collision(motion, early, agent.spec.radius, t_from=0.0, t_until=8.0, margin=m)
     assert hit is not None and hit.t < t_arrive
-    assert not agent._arrives_before(motion, 0.0, hit.t)
+    assert agent.guard.check(motion, early, 0.0, commit)[0] != "free_to_rest"
     kind, _ = agent._guard(Observation(0.0, state), 0.0, motion, early, early, "test")
     assert kind != "motion"
 

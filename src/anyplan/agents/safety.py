@@ -1,13 +1,14 @@
 """The safety invariant for agents that plan among moving obstacles, and its fallbacks.
 
 The robot only starts a motion M at t_s when M is predicted collision-free until it ends at rest
-("free to rest"), or when its *escape* (follow M until ``t_s + commit_s``, then brake to rest at
-a_max and alpha_max, :class:`Escape`) is predicted free until the robot stands and clears the
-static obstacles ("stoppable"); ``commit_s`` is the time the agent needs to act again. Otherwise
-:class:`SafetyGuard` keeps the current motion if it still passes, or takes the fallback
-(``brake``/``hold``, ``turn_away``, ``back_off``) with the largest certified predicted clearance
-over a horizon among those whose moving part is predicted free. Predictions:
-:func:`anyplan.prediction.collision.first_collision` with the robot radius plus ``margin``.
+or arrives at the goal ("free to rest"), or when its *escape* (follow M until
+``t_s + commit_s``, then brake to rest at a_max and alpha_max, :class:`Escape`) is predicted free
+until the robot stands and clears the static obstacles ("stoppable"); ``commit_s`` is the time
+the agent needs to act again. Otherwise :class:`SafetyGuard` keeps the current motion if it
+still passes, or takes the fallback (``brake``/``hold``, ``turn_away``, ``back_off``) with the
+largest certified predicted clearance over a horizon among those whose moving part is
+predicted free. Predictions: :func:`anyplan.prediction.collision.first_collision` with the robot
+radius plus ``margin``.
 Every decision is logged (:attr:`SafetyGuard.decisions`, JSON form :meth:`SafetyGuard.log`).
 Rule, API and tests: ``docs/sequential.md`` ("The safety invariant and its fallbacks").
 """
@@ -171,11 +172,27 @@ class SafetyGuard:
         return first_collision(motion, preds, self.spec.radius, t_from=t0, t_until=t1,
                                margin=margin, sample_dt=self.config.sample_dt)
 
+    def arrival(self, motion: Any, t: float) -> float:
+        """First time [s] from ``t`` at which ``motion`` is within half the goal tolerance of
+        the goal, where the run is over (on its positions every 20 ms); inf if it does not end
+        there."""
+        goal = np.asarray(self.spec.goal, dtype=float)
+        reach = 0.5 * self.spec.goal_tolerance
+        t_end = float(motion.t_end)
+        if t_end < t or math.hypot(*(motion.positions(np.array([t_end]))[0] - goal)) > reach:
+            return math.inf
+        ts = np.append(np.arange(t, t_end, 0.02), t_end)
+        p = motion.positions(ts)
+        return float(ts[np.argmax(np.hypot(p[:, 0] - goal[0], p[:, 1] - goal[1]) <= reach)])
+
     def check(self, motion: Any, preds: Sequence[PredictedObstacle], t: float, commit_s: float,
               margin: float | None = None, reach: Sequence[PredictedObstacle] = ()
               ) -> tuple[str, float | None, float | None, float | None]:
         """Whether ``motion`` may be started (or kept) at ``t`` [s].
 
+        A motion that ends at the goal is checked until it arrives (:meth:`arrival`): the run
+        is over there, as in the planners' own checks of a path's end at the goal, so a contact
+        predicted later, at rest at the goal, neither forbids it nor makes it merely stoppable.
         With ``reach`` (discs that contain everywhere an obstacle whose future is unknown can
         be, :func:`reachable_discs`), the motion must also be *passively safe*: its escape
         brings the robot to rest before any of them can touch it, so that a collision with an
@@ -191,7 +208,7 @@ class SafetyGuard:
         """
         m = self.config.margin if margin is None else margin
         t_end = max(float(motion.t_end), t)
-        hit = self._hit(motion, preds, t, t_end, m)
+        hit = self._hit(motion, preds, t, min(t_end, self.arrival(motion, t)), m)
         if hit is None and not reach:
             return "free_to_rest", None, t_end, None
         esc = Escape(motion, t + commit_s, self.spec, self.obstacles, self.spec.radius)

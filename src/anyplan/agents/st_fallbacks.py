@@ -62,8 +62,7 @@ class SafetyDecisions:
         dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit, reach,
                                 fallback=False)
         if dec.kind in ("motion", "keep"):
-            if dec.rule != "stoppable" or self._arrives_before(dec.trajectory, t_switch,
-                                                              dec.first_collision_s):
+            if dec.rule != "stoppable":
                 return dec.kind, dec.trajectory
             # stoppable, but struck later: it may stand the robot where the obstacle passes
             better = freer_evasion(self._ranker(), t_switch, state, safe, self._capped(safe),
@@ -78,22 +77,6 @@ class SafetyDecisions:
         self.record.fallbacks.append({"t": float(obs.t), "kind": kind, "reason": why,
                                       "predicted_clearance_m": finite_or_none(clear)})
         return kind, tr
-
-    def _arrives_before(self, motion: Trajectory | None, t: float, t_hit: float | None) -> bool:
-        """True if ``motion`` comes within half the goal tolerance of the goal, where the run
-        is over, between ``t`` and its first predicted collision ``t_hit`` [s] (a later contact
-        is not this task's: the same rule as the planner's own checks of a motion's end at the
-        goal, ``_tail_time``). Checked on the motion every 20 ms."""
-        if motion is None or t_hit is None:
-            return False
-        spec = self.spec
-        goal, reach = np.asarray(spec.goal, dtype=float), 0.5 * spec.goal_tolerance
-        t1 = min(float(t_hit), float(motion.t_end))
-        p0 = motion.positions(np.array([t]))[0]
-        if t1 < t or math.hypot(*(p0 - goal)) - float(motion.max_speed) * (t1 - t) > reach:
-            return False  # too far to get there in time
-        p = motion.positions(np.arange(t, t1 + 1e-9, 0.02))
-        return bool(np.any(np.hypot(p[:, 0] - goal[0], p[:, 1] - goal[1]) <= reach))
 
     def _reach(self, observed: list[PredictedObstacle], t: float,
                state: RobotState) -> list[PredictedObstacle]:
