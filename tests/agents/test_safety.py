@@ -43,6 +43,37 @@ def test_free_motion_is_started():
     assert guard.fallbacks == []
 
 
+def test_a_motion_to_the_goal_is_checked_until_it_arrives():
+    # The run is over within half the goal tolerance: an obstacle that crosses the goal 2 s
+    # after the robot's arrival strikes the motion only at rest there, after arrival, so the
+    # motion is free to rest; the same obstacle 2 s earlier is not.
+    from anyplan.trajectory.reference import HoldSegment
+    from anyplan.trajectory.trajectory import Trajectory
+
+    guard = SafetyGuard(SPEC, ROOM)
+    _, motion = _cruising()
+    goal, reach = np.asarray(SPEC.goal), 0.5 * SPEC.goal_tolerance
+    ts = np.linspace(0.0, float(motion.t_end), 20001)
+    inside = np.hypot(*(motion.positions(ts) - goal).T) <= reach
+    first = float(ts[np.argmax(inside)])
+    t_arr = guard.arrival(motion, 0.0)
+    assert first - 1e-9 <= t_arr <= first + 0.02 + 1e-9  # never before the true arrival
+    assert t_arr < float(motion.t_end)
+
+    def crossing(t_at_goal):  # down x = 11 at 0.4 m/s, over the goal at t_at_goal
+        return [PredictedObstacle("C", 0.3, UnicycleMotion(11.0, 4.0 + 0.4 * t_at_goal,
+                                                           -math.pi / 2, 0.4))]
+
+    late = crossing(t_arr + 2.0)
+    hit = first_collision(motion, late, SPEC.radius, margin=guard.config.margin)
+    assert hit is not None and hit.t > t_arr
+    assert guard.check(motion, late, 0.0, 0.2)[0] == "free_to_rest"
+    assert guard.check(motion, crossing(t_arr - 2.0), 0.0, 0.2)[0] != "free_to_rest"
+    # standing at the goal: arrived already, however long the hold; elsewhere: never
+    assert guard.arrival(Trajectory([HoldSegment(11.0, 4.0, 0.0, 0.0, 1e4)]), 5.0) == 5.0
+    assert guard.arrival(Trajectory([HoldSegment(5.0, 4.0, 0.0, 0.0, 1e4)]), 5.0) == math.inf
+
+
 def test_far_collision_is_stoppable_near_one_is_not():
     guard = SafetyGuard(SPEC, ROOM)
     state, motion = _cruising()

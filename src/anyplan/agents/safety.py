@@ -173,15 +173,15 @@ class SafetyGuard:
                                margin=margin, sample_dt=self.config.sample_dt)
 
     def arrival(self, motion: Any, t: float) -> float:
-        """First time [s] from ``t`` at which ``motion`` is within half the goal tolerance of
-        the goal, where the run is over (on its positions every 20 ms); inf if it does not end
-        there."""
+        """When ``motion`` arrives within half the goal tolerance of the goal, where the run is
+        over: the first of its samples from ``t`` [s] there (every 20 ms, or 4000 samples over a
+        longer motion), never before the true arrival; inf if it does not end there."""
         goal = np.asarray(self.spec.goal, dtype=float)
         reach = 0.5 * self.spec.goal_tolerance
         t_end = float(motion.t_end)
         if t_end < t or math.hypot(*(motion.positions(np.array([t_end]))[0] - goal)) > reach:
             return math.inf
-        ts = np.append(np.arange(t, t_end, 0.02), t_end)
+        ts = np.append(np.arange(t, t_end, max(0.02, (t_end - t) / 4000.0)), t_end)
         p = motion.positions(ts)
         return float(ts[np.argmax(np.hypot(p[:, 0] - goal[0], p[:, 1] - goal[1]) <= reach)])
 
