@@ -226,6 +226,35 @@ def test_guard_of_a_safety_replanning_checks_the_full_discs():
     assert max(o.growth.max_extra for o in seen[0]) == pytest.approx(1.0)
 
 
+def test_a_contact_after_arrival_at_the_goal_does_not_replan_the_motion_in_use():
+    # The motion in use ends at rest on the goal (11, 3). A parked obstacle 0.6 m beyond the
+    # goal is touched (with the check's margin) only in the last 2.5 cm before the end, after
+    # the robot is within half the goal tolerance, where the run is over: the check of the
+    # motion in use stops at the arrival, as the guard's does, and does not replan for it.
+    from anyplan.agents.base import Observation
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.prediction.collision import first_collision
+    from anyplan.world import RobotState, UnicycleMotion
+
+    sc = scenario_from_dict({**_crossing_scenario().to_dict(), "dynamic_obstacles": []})
+    agent = make_agent("st-bitstar", planning_delay=0.1)
+    agent.reset(sc, np.random.default_rng(0))
+    for t0 in (0.0, 0.1):
+        agent.act(Observation(t0, RobotState(1.0, 3.0, 0.0, 0.0, 0.0)))
+    traj = agent.trajectory
+    assert traj is not None
+    t = float(traj.t_end) - 6.0
+    st = traj.state(t)
+    parked = PredictedObstacle("P", 0.3, UnicycleMotion(11.6, 3.0, math.pi, 0.0))
+    hit = first_collision(traj, [parked], agent.spec.radius, t_from=t,
+                          margin=0.5 * agent.config.margin)
+    t_arr = agent.guard.arrival(traj, t)
+    assert hit is not None and t_arr < hit.t <= float(traj.t_end)  # only after arrival
+    n = len(agent.record.reasons)
+    agent._check(Observation(t, st), [parked])
+    assert not any(r.startswith("collision with P") for r in agent.record.reasons[n:])
+
+
 # The robot at 2 m/s before a wall (tests/conftest.py): plan_motion's best effort there starts
 # at about 1 m/s, ``feasible=False`` (as in DynaBARN world 53 at t = 1.3 s, at 1.5 m/s).
 def _fast_at_a_wall():

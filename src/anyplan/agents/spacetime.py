@@ -562,8 +562,9 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         t_until = min(max(traj.t_end, t) + 1.0, t + _CHECK_HORIZON_S)
         end = traj.positions(np.array([traj.t_end]))[0]
         if math.hypot(end[0] - spec.goal[0], end[1] - spec.goal[1]) <= 0.5 * spec.goal_tolerance:
-            # the run is over inside the goal tolerance: checked as planned (_timed_fn)
-            t_until = traj.t_end - self._tail_time(traj)
+            # the run is over inside the goal tolerance: checked as planned (_timed_fn), and
+            # as the guard checks it (until arrival)
+            t_until = min(traj.t_end - self._tail_time(traj), self.guard.arrival(traj, t))
         hit = verify(traj, planned, spec.radius, t_from=t, t_until=max(t_until, t),
                      margin=0.5 * self.config.margin)
         if hit is None:
