@@ -16,12 +16,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from anyplan.trajectory.spline import SmoothCurve
+from anyplan.trajectory.spline import ProfileArrays, SmoothCurve
 from anyplan.world.robot import RobotSpec
 
 __all__ = ["ProfileArrays", "SpeedProfile", "time_parameterize", "time_lower_bound"]
@@ -34,18 +33,6 @@ _FR = np.linspace(0.0, 1.0, SUBSAMPLES + 1)
 # keep the right end inside the same cubic piece: kappa' jumps at the knots
 _FR[-1] = 1.0 - 1e-9
 _FR[0] = 1e-9
-
-
-class ProfileArrays(NamedTuple):
-    """The grid of a :class:`SpeedProfile` as contiguous float arrays, one argument of compiled
-    kernels. Produced only by :attr:`SpeedProfile.arrays`."""
-
-    #: Arc length [m] at the grid, shape (M,).
-    s: np.ndarray
-    #: Speed [m/s] at the grid, shape (M,).
-    v: np.ndarray
-    #: Time [s] since the profile's start at the grid, shape (M,).
-    t: np.ndarray
 
 
 @dataclass

@@ -1,7 +1,8 @@
 """Cubic-spline smoothing of a piecewise-linear path, with certified collision checking.
 
-* :mod:`.curve`: :class:`SmoothCurve`, the arc-length C2 cubic through the path's points, and
-  :class:`CurveArrays`, its arrays as one record for compiled kernels;
+* :mod:`.curve`: :class:`SmoothCurve`, the arc-length C2 cubic through the path's points;
+* :mod:`.arrays`: :class:`CurveArrays` and :class:`ProfileArrays`, the curve's arrays and a speed
+  profile's grid as records for the compiled kernels;
 * :mod:`.clearance`: :func:`curve_clearance_ok`, the certified sweep test of a disc robot;
 * :mod:`.smooth`: :func:`smooth_path`, fit and repair until certified.
 
@@ -14,13 +15,14 @@ certification").
 
 from anyplan.trajectory.path import clean_path, shortcut_path
 from anyplan.trajectory.spline.clearance import curve_clearance_ok
-from anyplan.trajectory.spline.curve import MAX_TURN, START_KNOT, CurveArrays, SmoothCurve
+from anyplan.trajectory.spline.curve import MAX_TURN, START_KNOT, CurveArrays, ProfileArrays, SmoothCurve
 from anyplan.trajectory.spline.smooth import SmoothingResult, smooth_path
 
 __all__ = [
     "MAX_TURN",
     "START_KNOT",
     "CurveArrays",
+    "ProfileArrays",
     "SmoothCurve",
     "SmoothingResult",
     "clean_path",

@@ -27,7 +27,7 @@ from anyplan.geometry.collision import (
 from anyplan.trajectory.spline._pp import locate
 
 if TYPE_CHECKING:
-    from anyplan.trajectory.spline.curve import CurveArrays
+    from anyplan.trajectory.spline.arrays import CurveArrays
 
 
 #: Deferral distance [m] of :func:`certify_worst`: a piece whose chord clears the limit by more

@@ -18,8 +18,7 @@ from anyplan.trajectory.spline._arclength import hermite_one
 from anyplan.trajectory.spline._pp import curv_at, locate, piece
 
 if TYPE_CHECKING:
-    from anyplan.trajectory.profile import ProfileArrays
-    from anyplan.trajectory.spline.curve import CurveArrays
+    from anyplan.trajectory.spline.arrays import CurveArrays, ProfileArrays
 
 
 @njit(cache=True)

@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 
 if TYPE_CHECKING:
-    from anyplan.trajectory.spline.curve import CurveArrays
+    from anyplan.trajectory.spline.arrays import CurveArrays
 
 
 @njit(cache=True)

@@ -14,17 +14,14 @@ Construction and error bounds: ``docs/motion.md`` ("Smoothing and collision cert
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from anyplan.trajectory.spline import _drive, _fit, _pp
 from anyplan.trajectory.spline._arclength import GL_W, GL_X, hermite_u_of_s
+from anyplan.trajectory.spline.arrays import CurveArrays, ProfileArrays
 
-if TYPE_CHECKING:
-    from anyplan.trajectory.profile import ProfileArrays
-
-__all__ = ["CurveArrays", "SmoothCurve", "START_KNOT", "MAX_TURN"]
+__all__ = ["CurveArrays", "ProfileArrays", "SmoothCurve", "START_KNOT", "MAX_TURN"]
 
 # Sub-sample fractions of a piece used to estimate its tangent turn.
 _FR9 = np.linspace(0.0, 1.0, 9)
@@ -34,27 +31,6 @@ START_KNOT = 0.5
 
 #: Largest tangent turn [rad] across one evaluation-grid interval.
 MAX_TURN = 0.05
-
-
-class CurveArrays(NamedTuple):
-    """A :class:`SmoothCurve` as flat arrays, one argument of the compiled kernels. Produced only
-    by :class:`SmoothCurve` (from ``_fit.build_curve``).
-
-    P cubic pieces, N interpolation points, M evaluation-grid points.
-    """
-
-    #: Breakpoints (knots) of the piecewise cubic [m], shape (P + 1,).
-    x: np.ndarray
-    #: Coefficients in ascending powers of (u - x[i]) on piece i, shape (P, 4, 2).
-    c: np.ndarray
-    #: Curve parameter of each interpolation point, shape (N,).
-    point_u: np.ndarray
-    #: Evaluation grid in u, containing every knot, shape (M,).
-    u_grid: np.ndarray
-    #: Exact arc length [m] at ``u_grid``, shape (M,).
-    s_grid: np.ndarray
-    #: du/ds = 1 / |r'(u)| at ``u_grid``, shape (M,).
-    dus: np.ndarray
 
 
 class SmoothCurve:
