@@ -197,3 +197,52 @@ def test_goal_bounds_on_the_reachable_cells_only_give_the_same_answer(seed):
         if a is not None and b is not None:
             for f in ("t", "s", "v", "a"):
                 assert np.array_equal(getattr(a, f), getattr(b, f))
+
+
+def _goal_times_by_definition(forbidden, t_map, h, c_goal, reach, ds, v_max, c_first):
+    """The recurrence of ``goal_times``' docstring, scanned cell by cell in plain Python."""
+    nrow, ncell = forbidden.shape
+    g = np.full((nrow + 1, ncell), np.inf)
+    g[nrow, c_goal:] = t_map + nrow * h
+    for j in range(nrow - 1, -1, -1):
+        tj = t_map + j * h
+        c_end = ncell if c_first < 0 else min(ncell, c_first + j * reach + 1)
+        for c in range(c_end):
+            if c >= c_goal:
+                g[j, c] = tj
+            elif not forbidden[j, c]:
+                best = math.inf
+                for c2 in range(c, min(c + reach, ncell - 1) + 1):
+                    if forbidden[j, c2]:
+                        break
+                    if c2 >= c_goal:
+                        best = tj
+                        break
+                    best = min(best, g[j + 1, c2])
+                g[j, c] = max(best, tj + (c_goal - c - 1) * ds / v_max)
+    return g
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_goal_bounds_equal_their_recurrence_bit_for_bit(seed):
+    # goal_times reads the free rows at the map's end (after the predictions) in one step per
+    # cell; on random maps, forbidden cells early and late, with and without a free suffix and
+    # a frontier, every bound is the recurrence's, bit for bit.
+    from anyplan.trajectory.spacetime._lattice_kernels import goal_times
+
+    rng = np.random.default_rng(500 + seed)
+    nrow, ncell = int(rng.integers(40, 160)), int(rng.integers(20, 90))
+    forbidden = np.zeros((nrow, ncell), dtype=bool)
+    last = int(rng.integers(1, nrow)) if seed % 4 else nrow  # rows after it stay free
+    for _ in range(int(rng.integers(1, 12))):
+        c, j = int(rng.integers(0, ncell - 2)), int(rng.integers(0, last))
+        forbidden[j:min(j + int(rng.integers(1, 30)), last), c:c + int(rng.integers(1, 6))] = True
+    if seed == 5:
+        forbidden[nrow - 1, ncell // 2] = True  # no free suffix at all
+    c_goal = int(rng.integers(ncell // 2, ncell))
+    reach = int(rng.integers(1, 4))
+    t_map, h, ds, v_max = float(rng.uniform(-0.05, 2.0)), 0.05, 0.05, float(rng.uniform(0.5, 2.0))
+    for c_first in (-1, int(rng.integers(0, 4))):
+        got = goal_times(forbidden, t_map, h, c_goal, reach, ds, v_max, c_first)
+        want = _goal_times_by_definition(forbidden, t_map, h, c_goal, reach, ds, v_max, c_first)
+        assert np.array_equal(got, want)

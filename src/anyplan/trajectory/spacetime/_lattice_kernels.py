@@ -101,9 +101,29 @@ def goal_times(forbidden: np.ndarray, t_map: float, h: float, c_goal: int, reach
     g = np.full((nrow + 1, ncell), np.inf)
     for c in range(c_goal, ncell):
         g[nrow, c] = t_map + nrow * h
+    # While every row from j + 1 on is free, row j + 1 is nonincreasing in c (the last row is:
+    # inf, then the goal time; a free row's window minima of a nonincreasing row are the
+    # window ends, and the distance bound decreases in c), so the minimum over a window is its
+    # last cell: the same value as the scan below, read once. Obstacles are predicted over a
+    # few seconds and the map runs to the arrival, so most rows are such a free suffix.
+    suffix = True
     for j in range(nrow - 1, -1, -1):
         tj = t_map + j * h
         c_end = ncell if c_first < 0 else min(ncell, c_first + j * reach + 1)
+        if suffix:
+            for c in range(ncell):
+                if forbidden[j, c]:
+                    suffix = False
+                    break
+        if suffix:
+            for c in range(c_end):
+                if c >= c_goal:
+                    g[j, c] = tj
+                    continue
+                c2 = min(c + reach, ncell - 1)
+                best = tj if c2 >= c_goal else g[j + 1, c2]
+                g[j, c] = max(best, tj + (c_goal - c - 1) * ds / v_max)
+            continue
         for c in range(c_end):
             if c >= c_goal:
                 g[j, c] = tj
