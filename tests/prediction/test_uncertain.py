@@ -47,6 +47,21 @@ def test_growths_built_row_by_row_at_once_equal_the_growths_built_one_by_one():
         RadiusGrowth.rows([0.0, 1.0], taus, values[:1])
 
 
+def test_a_capped_growth_equals_the_growth_built_from_the_capped_values():
+    rng = np.random.default_rng(4)
+    taus = np.array([0.0, 0.5, 1.0, 2.0, 4.0])
+    for row in rng.normal(0.3, 0.4, (8, len(taus))):
+        g = RadiusGrowth(1.5, taus, row)
+        for cap in (0.0, 0.1, 0.3, float(g.max_extra), 2.0):
+            c = g.capped(cap)
+            ref = RadiusGrowth(1.5, taus, np.minimum(g.values, cap))
+            assert c.t0 == ref.t0 and c.rate == ref.rate and c.max_extra == ref.max_extra
+            assert np.array_equal(c.taus, ref.taus) and np.array_equal(c.values, ref.values)
+            assert c.max_extra <= cap
+    with pytest.raises(ValueError, match="cap"):
+        RadiusGrowth(0.0, taus, taus).capped(-0.1)
+
+
 def test_uncertainty_grows_with_the_horizon_and_with_occlusion():
     tr = Tracker(TrackerConfig(sigma_m=0.05))
     rng = np.random.default_rng(0)

@@ -116,7 +116,5 @@ class PlanningPredictions:
         if c is None:
             return preds
         return [o if o.growth is None or o.growth.max_extra <= c else
-                PredictedObstacle(o.name, o.radius, o.motion,
-                                  RadiusGrowth(o.growth.t0, o.growth.taus,
-                                               np.minimum(o.growth.values, c)), o.until)
+                PredictedObstacle(o.name, o.radius, o.motion, o.growth.capped(c), o.until)
                 for o in preds]

@@ -70,6 +70,23 @@ class RadiusGrowth:
             out.append(g)
         return out
 
+    def capped(self, cap: float) -> RadiusGrowth:
+        """This growth with its extra radius capped at ``cap`` [m] (>= 0): the same object as
+        ``RadiusGrowth(t0, taus, np.minimum(values, cap))``, built without checking again what
+        this one's construction checked (a capped row stays nonnegative and nondecreasing);
+        st-bitstar caps every uncertain prediction at every replanning."""
+        if not cap >= 0.0:
+            raise ValueError(f"cap must be >= 0, got {cap!r}")
+        v = np.minimum(self.values, cap)
+        g = object.__new__(type(self))
+        object.__setattr__(g, "t0", self.t0)
+        object.__setattr__(g, "taus", self.taus)
+        object.__setattr__(g, "values", v)
+        rate = (0.0 if len(v) < 2
+                else max(float(np.max(np.diff(v) / np.diff(self.taus))), 0.0))
+        object.__setattr__(g, "_rate", rate)
+        return g
+
     def at(self, t: np.ndarray | float) -> np.ndarray:
         """Extra radius [m] at absolute times ``t`` [s]."""
         return np.interp(np.asarray(t, dtype=float) - self.t0, self.taus, self.values)
