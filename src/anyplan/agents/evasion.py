@@ -19,11 +19,12 @@ from anyplan.agents.safety import Escape, SafetyGuard
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.prediction.base import PredictedObstacle
 from anyplan.prediction.collision import PredictedCollision, first_collision
-from anyplan.trajectory.motion import plan_motion, polyline_trajectory
+from anyplan.trajectory.kinds import MotionKind
+from anyplan.trajectory.motion import plan_motion, polyline_trajectory, swerve_trajectory
 from anyplan.world.robot import RobotSpec, RobotState
 
-__all__ = ["APPROACH_TOL", "EVADE_M", "MIN_EVADE_M", "FallbackRanker", "approach_speed",
-           "best_fallback", "escape_time_s", "free_length", "freer_evasion"]
+__all__ = ["APPROACH_TOL", "EVADE_M", "MIN_EVADE_M", "SWERVES", "SWERVE_S", "FallbackRanker",
+           "approach_speed", "best_fallback", "escape_time_s", "free_length", "freer_evasion"]
 
 #: Approach speed [m/s] at a predicted contact below which it counts as none (at rest or
 #: moving away; well below the 0.05 m/s robot-caused threshold of
@@ -37,6 +38,13 @@ EVADE_M = 1.5
 
 #: Shortest evasion [m]: a direction whose free run from the robot is shorter is left out.
 MIN_EVADE_M = 0.3
+
+#: Swerves: target twists (v / v_max, omega / omega_max), each held for :data:`SWERVE_S`.
+SWERVES = ((1.0, 1.0), (1.0, -1.0), (1.0, 0.5), (1.0, -0.5),
+           (0.5, 1.0), (0.5, -1.0), (0.5, 0.5), (0.5, -0.5))
+
+#: How long [s] a swerve holds its twist before braking.
+SWERVE_S = 1.5
 
 #: Bisection steps of :func:`free_length` (the length is found to ``dist / 2**6``).
 _FREE_STEPS = 6
@@ -114,10 +122,13 @@ class FallbackRanker:
         guard: The safety guard (its margin, horizon, sampling and clearance search).
         commit_s: Time [s] a fallback is followed before the robot can act again (the escape
             of the passive-safety check).
+        swerves: Offer the :data:`SWERVES` too (arcs entered at the robot's speed, then a
+            brake) when no prediction is uncertain (exact twists, announced motions).
     """
 
     def __init__(self, spec: RobotSpec, obstacles: ObstacleSet, guard: SafetyGuard,
-                 commit_s: float) -> None:
+                 commit_s: float, swerves: bool = False) -> None:
+        self.swerves = bool(swerves)
         self.spec = spec
         self.obstacles = obstacles
         self.guard = guard
@@ -140,7 +151,9 @@ class FallbackRanker:
         full discs; then free over it against the ``planned`` (capped) discs; then, when the
         planned discs strike it within :attr:`react_s`, met at rest or moving away rather than
         driving into the obstacle (:func:`approach_speed`); then the latest first contact
-        against the planned discs; then the largest clearance against the full discs. A hold
+        against the planned discs; then not a swerve (a swerve wins on none of these ties:
+        a robot with nothing to escape does not set off on an arc); then the largest
+        clearance against the full discs. A hold
         the planned discs run into thus loses to a motion they leave free (standing where an
         obstacle passes is a collision too), a short drive that stops just before an obstacle
         arrives does not beat a hold struck later, and a hold struck soon does not beat driving
@@ -155,7 +168,7 @@ class FallbackRanker:
     def head(self, tr: Any, t: float, full: Sequence[PredictedObstacle],
              planned: Sequence[PredictedObstacle], reach: Sequence[PredictedObstacle] = (),
              lazy: bool = True) -> tuple[tuple[Any, ...], float | None, float]:
-        """The first six parts of :meth:`rank`'s key (all but the clearance), the clearance
+        """The first seven parts of :meth:`rank`'s key (all but the clearance), the clearance
         [m] against the ``full`` discs when it was computed (None otherwise) and the end [s]
         of the horizon it is taken over.
 
@@ -188,7 +201,8 @@ class FallbackRanker:
         near = hit is not None and float(hit.t) - t < self.react_s
         return (bool(getattr(tr, "certified_free", True)), passive, clear_ok,
                 hit is None, -approach_speed(tr, hit) if near else 0.0,
-                math.inf if hit is None else float(hit.t)), clear, h
+                math.inf if hit is None else float(hit.t),
+                getattr(tr, "kind", None) != MotionKind.SWERVE), clear, h
 
     def _struck_within_margin(self, tr: Any, hit: PredictedCollision,
                               full: Sequence[PredictedObstacle]) -> bool:
@@ -214,7 +228,11 @@ class FallbackRanker:
         :func:`free_length`, at least :data:`MIN_EVADE_M`; with the guard's margin, or the
         clearance the robot has when it is closer to a wall) along a straight line from rest and,
         when the robot moves, along a smooth curve from its speed and heading (obstacles that
-        ignore the robot are escaped by moving, not only by stopping), and, last, keeping ``current``
+        ignore the robot are escaped by moving, not only by stopping), with :attr:`swerves` and
+        no uncertain prediction in ``safe`` the :data:`SWERVES` (arcs entered at the robot's
+        speed and turn rate within a_max and alpha_max, held :data:`SWERVE_S`, then a brake:
+        :func:`~anyplan.trajectory.motion.swerve_trajectory`; a differential-drive robot that
+        turns in place first stands in the obstacle's way), and, last, keeping ``current``
         (e.g. the curve that clears a wall when braking straight would not)."""
         spec, obstacles = self.spec, self.obstacles
         cands: list[tuple[str, Any]] = [(kind, tr) for kind, tr, _ in
@@ -244,6 +262,12 @@ class FallbackRanker:
                                  allow_turn=False)
                 if tr.certified_free and tr.feasible:
                     cands.append(("evade", tr))
+        if self.swerves and all(getattr(o, "growth", None) is None for o in safe):
+            for v1, w1 in SWERVES:
+                tr = swerve_trajectory(state, spec, obstacles, radius, t, v1 * spec.v_max,
+                                       w1 * spec.omega_max, SWERVE_S)
+                if tr.certified_free:
+                    cands.append(("swerve", tr))
         if current is not None and t < float(current.t_end) - 1e-9:
             cands.append(("keep", current))
         return cands

@@ -29,7 +29,7 @@ __all__ = ["SafetyDecisions"]
 class SafetyDecisions:
     """The safety decisions of an ``st-bitstar`` agent (a mixin: it reads the agent's ``spec``,
     ``obstacles``, ``guard``, ``reference``, ``_period``, ``trajectory``, ``record``,
-    ``passive_safety``, ``reach_extra_mps``, ``reach_min_speed_mps``, ``_capped`` and
+    ``passive_safety``, ``reach_extra_mps``, ``reach_min_speed_mps``, ``swerves``, ``_capped`` and
     ``_state_at``)."""
 
     spec: Any
@@ -41,6 +41,7 @@ class SafetyDecisions:
     passive_safety: bool
     reach_extra_mps: float
     reach_min_speed_mps: float
+    swerves: bool
     _capped: Callable[[list[PredictedObstacle]], list[PredictedObstacle]]  # PlanningPredictions'
     _state_at: Callable[[Observation, float], RobotState]  # ReplanningAgent's
     _period: Callable[[], float]  # the check period in force [s] (SpaceTimeBITStarAgent's)
@@ -106,7 +107,7 @@ class SafetyDecisions:
         return self._ranker().rank(tr, t, full, planned, reach)
 
     def _ranker(self) -> FallbackRanker:
-        return FallbackRanker(self.spec, self.obstacles, self.guard, self._period())
+        return FallbackRanker(self.spec, self.obstacles, self.guard, self._period(), self.swerves)
 
     def _fallback(self, obs: Observation, t_switch: float, preds: list[PredictedObstacle],
                   reason: str) -> Trajectory | None:

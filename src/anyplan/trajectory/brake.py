@@ -2,8 +2,9 @@
 
 :class:`BrakeSegment` tabulates the position by midpoint integration with the exact heading
 (step 2 ms, error O(dt^2 v omega) < 1e-6 m); heading and twist are exact. Its compiled
-evaluation (:func:`brake_eval`) is beside it. Notation: v0, omega0 the twist at the start,
-theta0 the heading, t0 the absolute start time [s].
+evaluation (:func:`brake_eval`) is beside it. :class:`SwerveSegment` ramps the twist to a target
+instead (a fallback's arc entered without stopping), tabulated the same way. Notation: v0,
+omega0 the twist at the start, theta0 the heading, t0 the absolute start time [s].
 See ``docs/motion.md`` ("``plan_motion`` and ``Trajectory``").
 """
 
@@ -17,7 +18,7 @@ from numba import njit
 from anyplan.trajectory.kinds import SegmentKind
 from anyplan.trajectory.segment import Sample, Segment
 
-__all__ = ["BrakeSegment", "brake_eval"]
+__all__ = ["BrakeSegment", "SwerveSegment", "brake_eval"]
 
 
 @njit(cache=True)
@@ -100,6 +101,54 @@ class BrakeSegment(Segment):
         out = brake_eval(t.ravel() - self.t0, self.t1 - self.t0, self.v0,
                          self.w0, self.theta0, self.a, self.al, self._tau, self._x, self._y)
         return tuple(o.reshape(t.shape) for o in out)
+
+    def path_points(self, step: float) -> np.ndarray:
+        return np.column_stack([self._x, self._y])
+
+
+class SwerveSegment(Segment):
+    """Swerving: v and omega ramp at a_max and alpha_max from (``v0``, ``omega0``) to a target
+    twist (``v1``, ``omega1``) and then hold it, from ``t0`` for ``duration`` [s]: an arc of the
+    unicycle entered without stopping first. The position is tabulated as
+    :class:`BrakeSegment`'s (midpoint integration with the exact heading, step ``dt``)."""
+
+    kind = SegmentKind.SWERVE
+
+    def __init__(self, x: float, y: float, theta: float, v0: float, omega0: float, v1: float,
+                 omega1: float, a_max: float, alpha_max: float, t0: float, duration: float,
+                 dt: float = 0.002) -> None:
+        self.v0, self.w0, self.v1, self.w1 = float(v0), float(omega0), float(v1), float(omega1)
+        self.a, self.al, self.theta0, self.t0 = a_max, alpha_max, float(theta), float(t0)
+        dur = max(float(duration), 0.0)
+        self.t1 = self.t0 + dur
+        n = max(2, math.ceil(dur / dt) + 1)
+        self._tau = np.linspace(0.0, dur, n)
+        tm = 0.5 * (self._tau[:-1] + self._tau[1:])
+        _, _, thm, vm, _ = self._twist(tm)
+        h = np.diff(self._tau)
+        self._x = x + np.concatenate([[0.0], np.cumsum(vm * np.cos(thm) * h)])
+        self._y = y + np.concatenate([[0.0], np.cumsum(vm * np.sin(thm) * h)])
+        self.max_speed = max(abs(self.v0), abs(self.v1)) * 1.001
+        self.length = float(np.sum(np.abs(vm) * h))
+
+    def _twist(self, tau: np.ndarray) -> Sample:
+        tau = np.asarray(tau, dtype=float)
+        tv = abs(self.v1 - self.v0) / self.a
+        tw = abs(self.w1 - self.w0) / self.al
+        sv = math.copysign(self.a, self.v1 - self.v0)
+        sw = math.copysign(self.al, self.w1 - self.w0)
+        cv, cw = np.minimum(tau, tv), np.minimum(tau, tw)
+        v = self.v0 + sv * cv
+        w = self.w0 + sw * cw
+        th = self.theta0 + self.w0 * cw + 0.5 * sw * cw * cw + self.w1 * np.maximum(tau - tw, 0.0)
+        z = np.zeros(tau.shape)
+        return z, z, th, v, w
+
+    def sample(self, t: np.ndarray) -> Sample:
+        t = np.asarray(t, dtype=float)
+        tau = np.clip(t - self.t0, 0.0, self.t1 - self.t0)
+        _, _, th, v, w = self._twist(tau)
+        return (np.interp(tau, self._tau, self._x), np.interp(tau, self._tau, self._y), th, v, w)
 
     def path_points(self, step: float) -> np.ndarray:
         return np.column_stack([self._x, self._y])

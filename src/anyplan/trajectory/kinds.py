@@ -31,6 +31,8 @@ class MotionKind(StrEnum):
     HOLD = "hold"
     #: An agent's fallback: brake and hold until a new plan.
     FALLBACK_HOLD = "fallback-hold"
+    #: An agent's fallback: an arc at a target twist entered without stopping, then brake.
+    SWERVE = "swerve"
 
 
 class SegmentKind(StrEnum):
@@ -44,6 +46,8 @@ class SegmentKind(StrEnum):
     BRAKE = "brake"
     #: Standing still.
     HOLD = "hold"
+    #: Ramping to a target twist and holding it (an arc entered without stopping).
+    SWERVE = "swerve"
     #: Driving along a curve with a space-time velocity plan.
     ST_CURVE = "st-curve"
 

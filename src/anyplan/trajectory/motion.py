@@ -20,6 +20,7 @@ import numpy as np
 
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.geometry.se2 import wrap_angle
+from anyplan.trajectory.brake import SwerveSegment
 from anyplan.trajectory.kinds import MotionKind
 from anyplan.trajectory.path import clean_path, polyline_length, shortcut_path
 from anyplan.trajectory.profile import time_lower_bound, time_parameterize
@@ -34,7 +35,8 @@ from anyplan.trajectory.trajectory import (
 from anyplan.trajectory.turn import rotation_profile
 from anyplan.world.robot import RobotSpec, RobotState
 
-__all__ = ["plan_motion", "turn_segment", "polyline_trajectory", "brake_to_rest", "continue_from"]
+__all__ = ["plan_motion", "turn_segment", "polyline_trajectory", "brake_to_rest", "continue_from",
+           "swerve_trajectory"]
 
 _EPS_V = 1e-6  # [m/s] speeds below this count as rest
 _EPS_TH = 1e-3  # [rad] headings closer than this count as aligned
@@ -81,6 +83,36 @@ def brake_to_rest(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, ra
         return [], t0, RobotState(state.x, state.y, state.theta, 0.0, state.omega), free
     bx, by, bth, _, _ = brake.sample(np.array([brake.t1]))
     return [brake], brake.t1, RobotState(float(bx[0]), float(by[0]), float(bth[0]), 0.0, 0.0), free
+
+
+def swerve_trajectory(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: float,
+                      t0: float, v1: float, omega1: float, duration: float) -> Trajectory:
+    """Swerve from ``state`` at ``t0`` [s]: ramp to the twist (``v1`` [m/s], ``omega1``
+    [rad/s]) within a_max and alpha_max and hold it until ``t0 + duration``, then brake to
+    rest (:class:`~anyplan.trajectory.brake.SwerveSegment`, then braking). An escape that
+    moves at once: evasions along straight lines first stop the robot's turn and face their
+    direction, which a differential-drive robot needs about a second for. ``certified_free``
+    tells whether the whole path is free for ``radius`` among ``obstacles`` (exact segment
+    tests along the 2 ms table, whose arcs leave their chords by far less than 1 um)."""
+    v1 = float(np.clip(v1, -spec.v_max, spec.v_max))
+    omega1 = float(np.clip(omega1, -spec.omega_max, spec.omega_max))
+    sw = SwerveSegment(state.x, state.y, state.theta, state.v, state.omega, v1, omega1,
+                       spec.a_max, spec.alpha_max, t0, duration)
+    pts = sw.path_points(0.0)
+    free = bool(np.all(obstacles.segments_clearance(pts[:-1], pts[1:]) >= radius + 1e-6 - COLLISION_EPS))
+    end = sw.sample(np.array([sw.t1]))
+    st_end = RobotState(*(float(a[0]) for a in end))
+    segs: list[Segment] = [sw]
+    brake, brake_free = _brake(st_end, spec, obstacles, radius, sw.t1)
+    if brake is not None:
+        segs.append(brake)
+    elif abs(st_end.omega) > 0.0:
+        segs.append(TurnSegment(st_end.x, st_end.y, rotation_profile(
+            st_end.theta, 0.0, spec.omega_max, spec.alpha_max, st_end.omega), sw.t1))
+    length = float(sum(s.length for s in segs))
+    return Trajectory(segs, kind=MotionKind.SWERVE,
+                      lower_bound_s=time_lower_bound(length, spec, abs(state.v)),
+                      certified_free=free and brake_free)
 
 
 def continue_from(p_stop: np.ndarray, pts: np.ndarray, obstacles: ObstacleSet,

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from anyplan.trajectory.brake import BrakeSegment
+from anyplan.trajectory.brake import BrakeSegment, SwerveSegment
 from anyplan.trajectory.kinds import MotionKind, SegmentKind
 from anyplan.trajectory.profile import SpeedProfile
 from anyplan.trajectory.segment import Sample, Segment
@@ -70,7 +70,7 @@ class CurveSegment(Segment):
 
 
 #: Segment types whose ``sample`` returns new arrays that share no memory.
-_FRESH = (CurveSegment, TurnSegment, BrakeSegment)
+_FRESH = (CurveSegment, TurnSegment, BrakeSegment, SwerveSegment)
 
 
 class Trajectory:
