@@ -44,7 +44,7 @@ SWERVES = ((1.0, 1.0), (1.0, -1.0), (1.0, 0.5), (1.0, -0.5),
            (0.5, 1.0), (0.5, -1.0), (0.5, 0.5), (0.5, -0.5))
 
 #: How long [s] a swerve holds its twist before braking.
-SWERVE_S = 1.5
+SWERVE_S = 1.0
 
 #: Bisection steps of :func:`free_length` (the length is found to ``dist / 2**6``).
 _FREE_STEPS = 6

@@ -124,7 +124,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             (:data:`~anyplan.agents.evasion.SWERVES`), when no prediction is uncertain (exact
             twists, announced motions): a differential-drive robot that turns in place first
             stands in the obstacle's way. Measured on DynaBARN 20-59, ``twist``, seeds 0-9:
-            336/400 reached with 35 robot-caused collisions, against 323/400 and 33 without;
+            339/400 reached with 31 robot-caused collisions, against 323/400 and 33 without;
             among uncertain discs (``tracked``) they added robot-caused collisions (17 -> 25-28
             of 200) and are not offered (``docs/perception.md``).
         twist_check_period_s: How often [s] the motion in use is checked while the obstacles
