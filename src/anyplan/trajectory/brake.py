@@ -60,59 +60,11 @@ def brake_eval(tau: np.ndarray, t_end: float, v0: float, w0: float, theta0: floa
     return out
 
 
-class BrakeSegment(Segment):
-    """Braking to rest: v and omega go to zero at a_max and alpha_max, from time ``t0`` [s]."""
-
-    kind = SegmentKind.BRAKE
-
-    def __init__(self, x: float, y: float, theta: float, v0: float, omega0: float, a_max: float,
-                 alpha_max: float, t0: float, dt: float = 0.002) -> None:
-        self.v0, self.w0, self.a, self.al = float(v0), float(omega0), a_max, alpha_max
-        self.theta0 = float(theta)
-        self.t0 = float(t0)
-        dur = max(abs(v0) / a_max, abs(omega0) / alpha_max)
-        self.t1 = self.t0 + dur
-        n = max(2, math.ceil(dur / dt) + 1)
-        self._tau = np.linspace(0.0, dur, n)
-        # Midpoint-of-interval integration with the exact heading: error O(dt^2 * v * omega).
-        tm = 0.5 * (self._tau[:-1] + self._tau[1:])
-        _, _, thm, vm, _ = self._twist(tm)
-        h = np.diff(self._tau)
-        self._x = x + np.concatenate([[0.0], np.cumsum(vm * np.cos(thm) * h)])
-        self._y = y + np.concatenate([[0.0], np.cumsum(vm * np.sin(thm) * h)])
-        self.max_speed = abs(self.v0) * 1.001
-        self.length = float(np.sum(np.abs(vm) * h))
-
-    def _twist(self, tau: np.ndarray) -> Sample:
-        tau = np.asarray(tau, dtype=float)
-        tv = abs(self.v0) / self.a
-        tw = abs(self.w0) / self.al
-        sv = math.copysign(self.a, self.v0)
-        sw = math.copysign(self.al, self.w0)
-        cv, cw = np.minimum(tau, tv), np.minimum(tau, tw)
-        v = self.v0 - sv * cv
-        w = self.w0 - sw * cw
-        th = self.theta0 + self.w0 * cw - 0.5 * sw * cw * cw
-        z = np.zeros(tau.shape)
-        return z, z, th, v, w
-
-    def sample(self, t: np.ndarray) -> Sample:
-        t = np.asarray(t, dtype=float)
-        out = brake_eval(t.ravel() - self.t0, self.t1 - self.t0, self.v0,
-                         self.w0, self.theta0, self.a, self.al, self._tau, self._x, self._y)
-        return tuple(o.reshape(t.shape) for o in out)
-
-    def path_points(self, step: float) -> np.ndarray:
-        return np.column_stack([self._x, self._y])
-
-
-class SwerveSegment(Segment):
-    """Swerving: v and omega ramp at a_max and alpha_max from (``v0``, ``omega0``) to a target
-    twist (``v1``, ``omega1``) and then hold it, from ``t0`` for ``duration`` [s]: an arc of the
-    unicycle entered without stopping first. The position is tabulated as
-    :class:`BrakeSegment`'s (midpoint integration with the exact heading, step ``dt``)."""
-
-    kind = SegmentKind.SWERVE
+class _RampSegment(Segment):
+    """v and omega ramped at a_max and alpha_max from (``v0``, ``omega0``) to (``v1``,
+    ``omega1``), then held, from absolute time ``t0`` for ``duration`` [s]. The position is
+    tabulated by midpoint integration with the exact heading (step ``dt``, error
+    O(dt^2 v omega)) and interpolated linearly in the table; heading and twist are exact."""
 
     def __init__(self, x: float, y: float, theta: float, v0: float, omega0: float, v1: float,
                  omega1: float, a_max: float, alpha_max: float, t0: float, duration: float,
@@ -144,11 +96,36 @@ class SwerveSegment(Segment):
         z = np.zeros(tau.shape)
         return z, z, th, v, w
 
+    def path_points(self, step: float) -> np.ndarray:
+        return np.column_stack([self._x, self._y])
+
+
+class BrakeSegment(_RampSegment):
+    """Braking to rest: v and omega go to zero at a_max and alpha_max, from time ``t0`` [s]."""
+
+    kind = SegmentKind.BRAKE
+
+    def __init__(self, x: float, y: float, theta: float, v0: float, omega0: float, a_max: float,
+                 alpha_max: float, t0: float, dt: float = 0.002) -> None:
+        super().__init__(x, y, theta, v0, omega0, 0.0, 0.0, a_max, alpha_max, t0,
+                         max(abs(v0) / a_max, abs(omega0) / alpha_max), dt)
+
+    def sample(self, t: np.ndarray) -> Sample:
+        t = np.asarray(t, dtype=float)
+        out = brake_eval(t.ravel() - self.t0, self.t1 - self.t0, self.v0,
+                         self.w0, self.theta0, self.a, self.al, self._tau, self._x, self._y)
+        return tuple(o.reshape(t.shape) for o in out)
+
+
+class SwerveSegment(_RampSegment):
+    """Swerving: v and omega ramp at a_max and alpha_max from (``v0``, ``omega0``) to a target
+    twist (``v1``, ``omega1``) and then hold it, from ``t0`` for ``duration`` [s]: an arc of the
+    unicycle entered without stopping first, tabulated as :class:`BrakeSegment`."""
+
+    kind = SegmentKind.SWERVE
+
     def sample(self, t: np.ndarray) -> Sample:
         t = np.asarray(t, dtype=float)
         tau = np.clip(t - self.t0, 0.0, self.t1 - self.t0)
         _, _, th, v, w = self._twist(tau)
         return (np.interp(tau, self._tau, self._x), np.interp(tau, self._tau, self._y), th, v, w)
-
-    def path_points(self, step: float) -> np.ndarray:
-        return np.column_stack([self._x, self._y])
