@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -200,26 +201,25 @@ def test_goal_bounds_on_the_reachable_cells_only_give_the_same_answer(seed):
 
 
 def _goal_times_by_definition(forbidden, t_map, h, c_goal, reach, ds, v_max, c_first):
-    """The recurrence of ``goal_times``' docstring, scanned cell by cell in plain Python."""
+    """The relaxation of ``goal_times``' docstring, written from its definition: from a free
+    cell the robot reaches, within a row, the free cells up to ``reach`` ahead (stopping at
+    the first forbidden one), and the goal at once if one of them is a goal cell."""
     nrow, ncell = forbidden.shape
     g = np.full((nrow + 1, ncell), np.inf)
     g[nrow, c_goal:] = t_map + nrow * h
-    for j in range(nrow - 1, -1, -1):
+    for j in reversed(range(nrow)):
         tj = t_map + j * h
-        c_end = ncell if c_first < 0 else min(ncell, c_first + j * reach + 1)
-        for c in range(c_end):
+        computed = ncell if c_first < 0 else min(ncell, c_first + j * reach + 1)
+        for c in range(computed):
             if c >= c_goal:
                 g[j, c] = tj
-            elif not forbidden[j, c]:
-                best = math.inf
-                for c2 in range(c, min(c + reach, ncell - 1) + 1):
-                    if forbidden[j, c2]:
-                        break
-                    if c2 >= c_goal:
-                        best = tj
-                        break
-                    best = min(best, g[j + 1, c2])
-                g[j, c] = max(best, tj + (c_goal - c - 1) * ds / v_max)
+                continue
+            if forbidden[j, c]:
+                continue
+            window = range(c, min(c + reach, ncell - 1) + 1)
+            cells = list(itertools.takewhile(lambda k, j=j: not forbidden[j, k], window))
+            best = tj if any(k >= c_goal for k in cells) else min(g[j + 1, k] for k in cells)
+            g[j, c] = max(best, tj + (c_goal - c - 1) * ds / v_max)
     return g
 
 
