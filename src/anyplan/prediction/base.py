@@ -22,9 +22,14 @@ def _normalised(taus: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.nd
     if k.ndim != 1 or len(k) < 1 or values.shape[1] != len(k) or np.any(np.diff(k) <= 0.0):
         raise ValueError("taus must be increasing and as long as values")
     v = np.maximum.accumulate(np.maximum(values, 0.0), axis=1)
-    rates = (np.zeros(len(v)) if len(k) < 2
-             else np.maximum(np.max(np.diff(v, axis=1) / np.diff(k), axis=1), 0.0))
-    return k, v, rates
+    return k, v, _slopes(k, v)
+
+
+def _slopes(k: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Each row's largest slope [m/s] over the knots ``k`` [s], at least 0 (0 with one knot)."""
+    if len(k) < 2:
+        return np.zeros(len(v))
+    return np.maximum(np.max(np.diff(v, axis=1) / np.diff(k), axis=1), 0.0)
 
 
 @dataclass(frozen=True)
@@ -82,9 +87,7 @@ class RadiusGrowth:
         object.__setattr__(g, "t0", self.t0)
         object.__setattr__(g, "taus", self.taus)
         object.__setattr__(g, "values", v)
-        rate = (0.0 if len(v) < 2
-                else max(float(np.max(np.diff(v) / np.diff(self.taus))), 0.0))
-        object.__setattr__(g, "_rate", rate)
+        object.__setattr__(g, "_rate", float(_slopes(self.taus, v[None, :])[0]))
         return g
 
     def at(self, t: np.ndarray | float) -> np.ndarray:

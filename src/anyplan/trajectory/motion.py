@@ -57,6 +57,14 @@ def turn_segment(x: float, y: float, theta: float, target: float, spec: RobotSpe
     return TurnSegment(x, y, best, t0)
 
 
+def _table_free(seg: BrakeSegment | SwerveSegment, obstacles: ObstacleSet, radius: float) -> bool:
+    """Whether a tabulated segment (braking, swerving) is certified free for ``radius``: its
+    reference is the table, whose consecutive samples are at most its speed x 2 ms apart (the
+    true arc leaves each chord by far less than 1 um), tested segment by segment, exactly."""
+    pts = seg.path_points(0.0)
+    return bool(np.all(obstacles.segments_clearance(pts[:-1], pts[1:]) >= radius + 1e-6 - COLLISION_EPS))
+
+
 def _brake(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: float,
            t0: float) -> tuple[BrakeSegment | None, bool]:
     """The braking segment (None at rest) and whether it is certified free."""
@@ -64,10 +72,7 @@ def _brake(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: f
         return None, True
     seg = BrakeSegment(state.x, state.y, state.theta, state.v, state.omega, spec.a_max,
                        spec.alpha_max, t0)
-    pts = seg.path_points(0.0)
-    # Consecutive samples are <= v0 * 2 ms apart; the arc leaves its chord by far less than 1 um.
-    free = bool(np.all(obstacles.segments_clearance(pts[:-1], pts[1:]) >= radius + 1e-6 - COLLISION_EPS))
-    return seg, free
+    return seg, _table_free(seg, obstacles, radius)
 
 
 def brake_to_rest(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: float,
@@ -98,8 +103,7 @@ def swerve_trajectory(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet
     omega1 = float(np.clip(omega1, -spec.omega_max, spec.omega_max))
     sw = SwerveSegment(state.x, state.y, state.theta, state.v, state.omega, v1, omega1,
                        spec.a_max, spec.alpha_max, t0, duration)
-    pts = sw.path_points(0.0)
-    free = bool(np.all(obstacles.segments_clearance(pts[:-1], pts[1:]) >= radius + 1e-6 - COLLISION_EPS))
+    free = _table_free(sw, obstacles, radius)
     end = sw.sample(np.array([sw.t1]))
     st_end = RobotState(*(float(a[0]) for a in end))
     segs: list[Segment] = [sw]
