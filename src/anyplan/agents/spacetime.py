@@ -397,6 +397,9 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         self._whole_call(obs, lambda: self._replan_call(obs, preds, reason))
 
     def _replan_call(self, obs: Observation, preds: list[PredictedObstacle], reason: str) -> None:
+        # BIT* draws from this call's own generator, spawned whether or not the call searches:
+        # a call that needs no search leaves the later calls' samples as they were.
+        rng = self.rng.spawn(1)[0]
         dt, d, t_ready, state = self._begin_replan(obs)
         t = obs.t
         observed = preds
@@ -444,7 +447,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
                                                   else None),
                                    chain=self._chain if inc is not None else (),
                                    verified=self._is_candidate,
-                                   stop=self._out_of_budget if long_bound else None)
+                                   stop=self._out_of_budget if long_bound else None, rng=rng)
         # an improvement call goes on where the budget cut this one: before a search (the
         # squares it would have searched among) or before a timing (the path's squares)
         self._chain = []

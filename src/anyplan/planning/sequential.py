@@ -285,7 +285,8 @@ class SequentialBITStar:
                t_now: float, motion: MotionModel | None = None,
                chain: Sequence[VirtualObstacle] = (),
                verified: Callable[[TimedMotion], bool] | None = None,
-               stop: Callable[[Sequence[VirtualObstacle]], bool] | None = None) -> SequentialResult:
+               stop: Callable[[Sequence[VirtualObstacle]], bool] | None = None,
+               rng: np.random.Generator | None = None) -> SequentialResult:
         """Plan from ``start`` to ``goal`` until the predicted motion is collision-free.
 
         Args:
@@ -302,6 +303,8 @@ class SequentialBITStar:
             stop: Asked before each search after this replanning's first, with the squares it
                 would search among: True ends the iterations there, as ``max_time_s`` does
                 (an anytime caller's budget, spent before a search rather than after it).
+            rng: BIT*'s generator for this replanning (default: the loop's own, whose stream
+                runs on from one replanning to the next).
         """
         motion_fn = motion or self.motion
         if motion_fn is None:
@@ -324,7 +327,8 @@ class SequentialBITStar:
         if squares and not (with_squares.start_valid() and with_squares.goal_valid()):
             squares, with_squares = [], problem  # the robot moved into one: start afresh
         first_it = len(squares)
-        planner = BITStar(with_squares, cfg.bitstar, rng=self.rng)
+        gen = self.rng if rng is None else rng
+        planner = BITStar(with_squares, cfg.bitstar, rng=gen)
         best: SequentialResult | None = None
         blocked = False
         status = "collision_predicted"
@@ -335,7 +339,7 @@ class SequentialBITStar:
                 break
             if not cfg.warm_start and it > 0:
                 planner = BITStar(problem.with_shapes([s.shape for s in squares]), cfg.bitstar,
-                                  rng=self.rng)
+                                  rng=gen)
             # the first plan's budget for the plan among the static obstacles only (a chain
             # taken up starts with a detour search)
             self._solve(planner, not squares)
