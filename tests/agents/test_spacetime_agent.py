@@ -106,6 +106,7 @@ def test_result_fields():
     assert 0 <= ex["st_timed"] <= len(d["plans"])
     assert len(ex["st_candidates"]) == len(d["planning_times_s"])
     assert isinstance(ex["st_pruned"], int) and ex["st_pruned"] >= 0
+    assert isinstance(ex["st_trapped"], int) and 0 <= ex["st_trapped"] <= len(d["planning_times_s"])
     assert all(p["arrival_s"] >= p["t_start"] for p in d["plans"])
     # re-timed ("st+..."), or a plan_motion kind when the untimed motion was already free
     assert all(p["kind"].startswith("st+") or p["kind"] in ("smooth", "turn+smooth",

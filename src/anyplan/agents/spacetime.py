@@ -419,7 +419,10 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         self._search_deadline = None if budget is None else w0 + budget
         self._last_build = self._last_cycle = self._stopped_at = None
         res: SequentialResult | None = None
-        if inc is None and self._path is not None and len(self._path) >= 2:
+        if inc is None and self._trapped(preds, state, t_ready):
+            # every motion from the state meets a planned disc: no search can time one
+            res = SequentialResult("collision_predicted", np.zeros((0, 2)), None, [], 0)
+        if res is None and inc is None and self._path is not None and len(self._path) >= 2:
             # First the path in use, from where the robot will be: no new search if it can be
             # timed within patience_s.
             rest = remaining_path(self._path, np.array([state.x, state.y]))

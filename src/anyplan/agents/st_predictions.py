@@ -4,7 +4,8 @@ Certain predictions (announced motions; exact twists with ``guard="growth"``) ar
 against in full, announced motions up to ``announced_horizon_s`` ahead. Uncertain ones
 (tracked: discs that grow with the horizon) are planned and timed against discs whose extra
 radius is capped at ``plan_extra_m``, on a receding horizon, while the safety guard checks the
-full growth (``docs/perception.md``, "st-bitstar when the future is unknown").
+full growth (``docs/perception.md``, "st-bitstar when the future is unknown"). When one
+planned disc holds every place the robot can reach, no search is made (``_trapped``).
 :class:`PlanningPredictions` is the agent's part that makes these views.
 """
 
@@ -17,11 +18,15 @@ from typing import Any
 import numpy as np
 
 from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
+from anyplan.prediction.trap import first_trap
+from anyplan.world.robot import RobotState
 
 __all__ = ["PlanningPredictions"]
 
 #: Gap [m] a predicted disc that already holds the robot is shrunk to (``_planning_preds``).
 _INSIDE_GAP_M = 0.02
+#: How far ahead [s] a trap is looked for (the robot's reach outgrows every disc well before).
+_TRAP_HORIZON_S = 10.0
 
 
 class PlanningPredictions:
@@ -118,3 +123,17 @@ class PlanningPredictions:
         return [o if o.growth is None or o.growth.max_extra <= c else
                 PredictedObstacle(o.name, o.radius, o.motion, o.growth.capped(c), o.until)
                 for o in preds]
+
+    def _trapped(self, preds: list[PredictedObstacle], state: RobotState, t: float) -> bool:
+        """Whether a planned disc holds every place the robot can reach from ``state`` at
+        ``t`` [s] (:func:`~anyplan.prediction.trap.first_trap`, against the contact distance
+        of the candidates' check) before any motion could end near the goal: then no motion
+        from there is free, and every search and timing would be in vain (counted in
+        ``st_trapped``)."""
+        spec = self.spec
+        to_goal = math.hypot(spec.goal[0] - state.x, spec.goal[1] - state.y)
+        trap = first_trap(preds, (state.x, state.y), state.v, t, spec.radius, spec.v_max,
+                          spec.a_max, self.config.margin, _TRAP_HORIZON_S,
+                          reach_cap_m=to_goal - 0.5 * spec.goal_tolerance)
+        self.record.st_trapped += trap is not None
+        return trap is not None

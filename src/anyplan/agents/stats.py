@@ -145,6 +145,8 @@ class SpaceTimeStats(SequentialStats):
         st_pruned: Loop paths left untimed because their untimed motion arrives no earlier than
             a timed candidate, or because the search budget had run out once a candidate was
             timed (each ends its replanning's search).
+        st_trapped: Replannings that did not search: a planned disc held every place the robot
+            could reach (:func:`~anyplan.prediction.trap.first_trap`), so no motion was free.
         inside_discs: Predicted discs that already held the robot when it planned, shrunk to
             let it leave (uncertain predictions only; left out when None).
     """
@@ -152,13 +154,14 @@ class SpaceTimeStats(SequentialStats):
     KEYS: ClassVar[tuple[str, ...]] = (
         "statuses", "iterations", "late_plans", "plan_time_s", "motion_time_s", "replan_times_s",
         "waits", "fallbacks", "safety_time_s", "st_waits_s", "st_timed", "st_candidates",
-        "st_pruned", "inside_discs", "reasons", "progress", "safety", "tracking", *_TRACKING)
+        "st_pruned", "st_trapped", "inside_discs", "reasons", "progress", "safety", "tracking", *_TRACKING)
     OPTIONAL: ClassVar[frozenset[str]] = SequentialStats.OPTIONAL | {"inside_discs"}
 
     st_waits_s: list[float] = field(default_factory=list)
     st_timed: int = 0
     st_candidates: list[int] = field(default_factory=list)
     st_pruned: int = 0
+    st_trapped: int = 0
     inside_discs: int | None = None
 
 
