@@ -3,8 +3,10 @@
 Runs st-bitstar deterministically (its ``deterministic_settings``: ``planning_delay=0.1,
 batches_per_plan=2, max_time_s=10``, no search budget) on
 paper-1..3 (``--seeds`` seeds), the first ``--random`` scenarios of ``random_suite(0)``,
-``gap_suite(0, n=--gaps)`` and ``--dynabarn`` of DynaBARN's medium and hard worlds (20-59, evenly
-spread; tracks announced, as in ``benchmarks/spacetime.py``), and records for every run its
+``gap_suite(0, n=--gaps)``, ``--dynabarn`` of DynaBARN's medium and hard worlds (20-59, evenly
+spread; tracks announced, as in ``benchmarks/spacetime.py``, or perceived as ``--dynabarn-mode``
+says) and ``--crowds`` windows of each recorded crowd and of the dense overlay (``tracked``,
+as ``benchmarks/unknown.py`` builds them), and records for every run its
 status, time to goal, executed trajectory and planned paths (a fingerprint), and the CPU time
 (``time.process_time``) of every planning call (``_replan``). With ``--trees A,B`` each repetition
 runs one worker process per tree, alternating, so that the load of the shared machine falls on
@@ -48,7 +50,32 @@ def _scenarios(args: argparse.Namespace) -> list[tuple[str, Any, list[int]]]:
         for i in np.linspace(20, 59, args.dynabarn).round().astype(int):
             d = world_to_scenario(worlds[int(i)])
             sc = d if not isinstance(d, dict) else scenario_from_dict(d, f"<dynabarn {i}>")
+            if args.dynabarn_mode != "oracle":
+                from anyplan.simulation.perception import override_sensing
+
+                sc = override_sensing(sc, args.dynabarn_mode)
             out.append(("dynabarn", sc, [0]))
+    if args.crowds > 0:
+        out += _crowds(args.crowds_dir, args.crowds)
+    return out
+
+
+def _crowds(folder: str, n: int) -> list[tuple[str, Any, list[int]]]:
+    """The first ``n`` windows of ETH hotel and UCY zara01 (``crowds``) and of zara01 overlaid
+    ten times (``dense``), ``tracked``, as ``benchmarks/unknown.py`` runs them."""
+    from anyplan.experiments.crowds import CrowdOptions, crowd_scenarios, read_obsmat
+    from anyplan.simulation.perception import override_sensing
+    from anyplan.world.scenario import scenario_from_dict
+
+    out: list[tuple[str, Any, list[int]]] = []
+    zara = read_obsmat(os.path.join(folder, "ucy_zara01_obsmat.txt"))
+    for suite, data in (
+            ("crowds", crowd_scenarios(read_obsmat(os.path.join(folder, "eth_hotel_obsmat.txt")),
+                                       "eth-hotel")[:n] + crowd_scenarios(zara, "ucy-zara01")[:n]),
+            ("dense", crowd_scenarios(zara, "zara01", CrowdOptions(
+                window_s=30.0, step_s=30.0, copies=10, copy_shift_s=31.0))[:n])):
+        out += [(suite, override_sensing(scenario_from_dict(d, d["name"]), "tracked"), [0])
+                for d in data]
     return out
 
 
@@ -107,7 +134,9 @@ def driver(args: argparse.Namespace) -> int:
     trees = [os.path.abspath(t) for t in args.trees.split(",")]
     results: dict[str, list[dict[str, Any]]] = {t: [] for t in trees}
     flags = ["--seeds", str(args.seeds), "--random", str(args.random), "--gaps", str(args.gaps),
-             "--dynabarn", str(args.dynabarn), "--worlds-file", args.worlds_file, "--mode", args.mode]
+             "--dynabarn", str(args.dynabarn), "--worlds-file", args.worlds_file, "--mode", args.mode,
+             "--dynabarn-mode", args.dynabarn_mode, "--crowds", str(args.crowds),
+             "--crowds-dir", args.crowds_dir]
     for rep in range(args.reps):
         for t in trees:
             env = dict(os.environ, PYTHONPATH=os.path.join(t, "src"))
@@ -136,7 +165,7 @@ def driver(args: argparse.Namespace) -> int:
     print("| suite | calls | " + " | ".join(f"{os.path.basename(t)} med / p95" for t in trees)
           + " | ratio med | ratio p95 |")
     print("|---|---|" + "---|" * len(trees) + "---|---|")
-    for suite in ("paper", "random", "gaps", "dynabarn", "all"):
+    for suite in ("paper", "random", "gaps", "dynabarn", "crowds", "dense", "all"):
         per = []
         for t in trees:
             x = [c for rep in results[t] for r in rep["runs"]
@@ -167,6 +196,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--gaps", type=int, default=6)
     ap.add_argument("--dynabarn", type=int, default=0, help="DynaBARN worlds of 20-59 (default 0)")
     ap.add_argument("--worlds-file", default="/work/shared/benchmarks/dynabarn/worlds.json")
+    ap.add_argument("--dynabarn-mode", choices=("oracle", "twist", "tracked"), default="oracle",
+                    help="perception of the DynaBARN worlds (default oracle: tracks announced)")
+    ap.add_argument("--crowds", type=int, default=0,
+                    help="windows of each recorded crowd and of the dense overlay (default 0)")
+    ap.add_argument("--crowds-dir", default="/work/shared/benchmarks/crowds")
     ap.add_argument("--mode", choices=("deterministic", "bench"), default="deterministic",
                     help="deterministic (batch budget: decisions compared) or bench (the "
                     "benchmark's time budget: decisions may differ with the load; timing only)")
