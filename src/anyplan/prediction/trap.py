@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from anyplan.prediction.base import PredictedObstacle
+from anyplan.world.motion import UnicycleMotion
 
 __all__ = ["Trap", "first_trap", "reach_m"]
 
@@ -43,6 +44,17 @@ def reach_m(speed: float, v_max: float, a_max: float, tau: np.ndarray) -> np.nda
     ramp = v0 * tau + 0.5 * a_max * tau * tau
     top = v0 * t_top + 0.5 * a_max * t_top * t_top + v_max * (tau - t_top)
     return np.where(tau <= t_top, ramp, top)
+
+
+def _centre(o: PredictedObstacle, t: float) -> tuple[float, float]:
+    """The predicted centre [m] at ``t`` [s]; in closed form on a straight line (a filter's
+    input: the same point as ``positions`` up to rounding, far below its 1 um of slack)."""
+    m = o.motion
+    if isinstance(m, UnicycleMotion) and m.omega == 0.0:
+        run = m.v * max(t - m.start_time, 0.0)
+        return m.x0 + run * math.cos(m.theta0), m.y0 + run * math.sin(m.theta0)
+    q = np.asarray(o.positions(np.array([t])), dtype=float)[0]
+    return float(q[0]), float(q[1])
 
 
 @dataclass(frozen=True)
@@ -96,8 +108,8 @@ def first_trap(preds: Sequence[PredictedObstacle], position: tuple[float, float]
     best: Trap | None = None
     for o in preds:
         # the disc must come within `widest` of the robot while its reach is that small
-        q0 = np.asarray(o.positions(np.array([t0])), dtype=float)[0]
-        if math.hypot(*(q0 - p)) - float(o.max_speed) * float(tau[-1]) >= widest:
+        qx, qy = _centre(o, t0)
+        if math.hypot(qx - p[0], qy - p[1]) - float(o.max_speed) * float(tau[-1]) >= widest + 1e-6:
             continue
         q = np.asarray(o.positions(t), dtype=float).reshape(-1, 2)
         r = np.asarray(o.radius_at(t), dtype=float)
