@@ -27,8 +27,8 @@ from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.moving import closest_approach
 from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
 from anyplan.prediction.collision import first_collision
-from anyplan.trajectory.motion import brake_to_rest, polyline_trajectory
-from anyplan.trajectory.reference import HoldSegment, come_to_rest
+from anyplan.trajectory.motion import brake_to_rest, come_to_rest, polyline_trajectory
+from anyplan.trajectory.reference import HoldSegment
 from anyplan.trajectory.trajectory import BrakeSegment, Trajectory
 from anyplan.world.motion import UnicycleMotion
 from anyplan.world.robot import RobotSpec, RobotState

@@ -35,8 +35,8 @@ from anyplan.trajectory.trajectory import (
 from anyplan.trajectory.turn import rotation_profile
 from anyplan.world.robot import RobotSpec, RobotState
 
-__all__ = ["plan_motion", "turn_segment", "polyline_trajectory", "brake_to_rest", "continue_from",
-           "swerve_trajectory"]
+__all__ = ["plan_motion", "turn_segment", "polyline_trajectory", "brake_to_rest", "come_to_rest",
+           "continue_from", "swerve_trajectory"]
 
 _EPS_V = 1e-6  # [m/s] speeds below this count as rest
 _EPS_TH = 1e-3  # [rad] headings closer than this count as aligned
@@ -90,6 +90,26 @@ def brake_to_rest(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, ra
     return [brake], brake.t1, RobotState(float(bx[0]), float(by[0]), float(bth[0]), 0.0, 0.0), free
 
 
+def come_to_rest(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: float,
+                 t0: float) -> tuple[list[Segment], float, RobotState, bool]:
+    """Brake to rest at a_max from ``state`` at ``t0`` [s], then stop any rotation in place at
+    alpha_max.
+
+    Returns:
+        The segments, the time [s] the robot is at rest (v = omega = 0), its state then, and
+        whether the braking path is certified free for ``radius`` [m].
+    """
+    segs, t, rest, free = brake_to_rest(state, spec, obstacles, radius, t0)
+    if abs(rest.omega) > 1e-9:  # turning in place: stop the rotation at alpha_max too
+        stop = BrakeSegment(rest.x, rest.y, rest.theta, 0.0, rest.omega, spec.a_max,
+                            spec.alpha_max, t)
+        segs.append(stop)
+        t = stop.t1
+        x, y, th, _, _ = stop.sample(np.array([t]))
+        return segs, t, RobotState(float(x[0]), float(y[0]), float(th[0]), 0.0, 0.0), free
+    return segs, t, RobotState(rest.x, rest.y, rest.theta, 0.0, 0.0), free
+
+
 def swerve_trajectory(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: float,
                       t0: float, v1: float, omega1: float, duration: float) -> Trajectory:
     """Swerve from ``state`` at ``t0`` [s]: ramp to the twist (``v1`` [m/s], ``omega1``
@@ -105,14 +125,9 @@ def swerve_trajectory(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet
                        spec.a_max, spec.alpha_max, t0, duration)
     free = _table_free(sw, obstacles, radius)
     end = sw.sample(np.array([sw.t1]))
-    st_end = RobotState(*(float(a[0]) for a in end))
-    segs: list[Segment] = [sw]
-    brake, brake_free = _brake(st_end, spec, obstacles, radius, sw.t1)
-    if brake is not None:
-        segs.append(brake)
-    elif abs(st_end.omega) > 0.0:
-        segs.append(TurnSegment(st_end.x, st_end.y, rotation_profile(
-            st_end.theta, 0.0, spec.omega_max, spec.alpha_max, st_end.omega), sw.t1))
+    rest, _, _, brake_free = come_to_rest(RobotState(*(float(a[0]) for a in end)), spec,
+                                          obstacles, radius, sw.t1)
+    segs: list[Segment] = [sw, *rest]
     length = float(sum(s.length for s in segs))
     return Trajectory(segs, kind=MotionKind.SWERVE,
                       lower_bound_s=time_lower_bound(length, spec, abs(state.v)),

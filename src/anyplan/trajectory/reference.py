@@ -22,11 +22,11 @@ import numpy as np
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.shapes import Shape
 from anyplan.trajectory.kinds import SegmentKind
-from anyplan.trajectory.motion import brake_to_rest, continue_from, plan_motion
-from anyplan.trajectory.trajectory import BrakeSegment, Segment, Trajectory
+from anyplan.trajectory.motion import brake_to_rest, come_to_rest, continue_from, plan_motion
+from anyplan.trajectory.trajectory import Segment, Trajectory
 from anyplan.world.robot import RobotSpec, RobotState
 
-__all__ = ["HoldSegment", "ReferenceBuilder", "Departure", "come_to_rest", "WAIT_PREFIX"]
+__all__ = ["HoldSegment", "ReferenceBuilder", "Departure", "WAIT_PREFIX"]
 
 #: Prefix of the kind of a motion departing late (``"wait+smooth"``, ...).
 WAIT_PREFIX = "wait+"
@@ -50,26 +50,6 @@ class HoldSegment(Segment):
 
     def path_points(self, step: float) -> np.ndarray:
         return np.array([[self.x, self.y]])
-
-
-def come_to_rest(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: float,
-                 t0: float) -> tuple[list[Segment], float, RobotState, bool]:
-    """Brake to rest at a_max from ``state`` at ``t0`` [s], then stop any rotation in place at
-    alpha_max.
-
-    Returns:
-        The segments, the time [s] the robot is at rest (v = omega = 0), its state then, and
-        whether the braking path is certified free for ``radius`` [m].
-    """
-    segs, t, rest, free = brake_to_rest(state, spec, obstacles, radius, t0)
-    if abs(rest.omega) > 1e-9:  # turning in place: stop the rotation at alpha_max too
-        stop = BrakeSegment(rest.x, rest.y, rest.theta, 0.0, rest.omega, spec.a_max,
-                            spec.alpha_max, t)
-        segs.append(stop)
-        t = stop.t1
-        x, y, th, _, _ = stop.sample(np.array([t]))
-        return segs, t, RobotState(float(x[0]), float(y[0]), float(th[0]), 0.0, 0.0), free
-    return segs, t, RobotState(rest.x, rest.y, rest.theta, 0.0, 0.0), free
 
 
 class ReferenceBuilder:
