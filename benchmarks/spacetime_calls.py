@@ -57,27 +57,21 @@ def _scenarios(args: argparse.Namespace) -> list[tuple[str, Any, list[int]]]:
                 sc = override_sensing(sc, args.dynabarn_mode)
             out.append(("dynabarn", sc, [0]))
     if args.crowds > 0:
-        out += _crowds(args.crowds_dir, args.crowds)
+        out += _crowds(args.crowds)
     return out
 
 
-def _crowds(folder: str, n: int) -> list[tuple[str, Any, list[int]]]:
+def _crowds(n: int) -> list[tuple[str, Any, list[int]]]:
     """The first ``n`` windows of ETH hotel and UCY zara01 (``crowds``) and of zara01 overlaid
-    ten times (``dense``), ``tracked``, as ``benchmarks/unknown.py`` runs them."""
-    from anyplan.experiments.crowds import CrowdOptions, crowd_scenarios, read_obsmat
+    ten times (``dense``), ``tracked``: ``benchmarks/unknown.py``'s crowd windows."""
+    import unknown  # benchmarks/unknown.py, beside this script (as benchmarks/contacts.py)
+
     from anyplan.simulation.perception import override_sensing
     from anyplan.world.scenario import scenario_from_dict
 
-    out: list[tuple[str, Any, list[int]]] = []
-    zara = read_obsmat(os.path.join(folder, "ucy_zara01_obsmat.txt"))
-    for suite, data in (
-            ("crowds", crowd_scenarios(read_obsmat(os.path.join(folder, "eth_hotel_obsmat.txt")),
-                                       "eth-hotel")[:n] + crowd_scenarios(zara, "ucy-zara01")[:n]),
-            ("dense", crowd_scenarios(zara, "zara01", CrowdOptions(
-                window_s=30.0, step_s=30.0, copies=10, copy_shift_s=31.0))[:n])):
-        out += [(suite, override_sensing(scenario_from_dict(d, d["name"]), "tracked"), [0])
-                for d in data]
-    return out
+    return [("dense" if tag == "crowds-dense" else "crowds",
+             override_sensing(scenario_from_dict(d, d["name"]), "tracked"), [0])
+            for tag, d in unknown._crowds(n)]
 
 
 def _digest(obj: Any) -> str:
@@ -136,8 +130,7 @@ def driver(args: argparse.Namespace) -> int:
     results: dict[str, list[dict[str, Any]]] = {t: [] for t in trees}
     flags = ["--seeds", str(args.seeds), "--random", str(args.random), "--gaps", str(args.gaps),
              "--dynabarn", str(args.dynabarn), "--worlds-file", args.worlds_file, "--mode", args.mode,
-             "--dynabarn-mode", args.dynabarn_mode, "--crowds", str(args.crowds),
-             "--crowds-dir", args.crowds_dir]
+             "--dynabarn-mode", args.dynabarn_mode, "--crowds", str(args.crowds)]
     for rep in range(args.reps):
         for t in trees:
             env = dict(os.environ, PYTHONPATH=os.path.join(t, "src"))
@@ -204,7 +197,6 @@ def main(argv: list[str] | None = None) -> int:
                     help="perception of the DynaBARN worlds (default oracle: tracks announced)")
     ap.add_argument("--crowds", type=int, default=0,
                     help="windows of each recorded crowd and of the dense overlay (default 0)")
-    ap.add_argument("--crowds-dir", default="/work/shared/benchmarks/crowds")
     ap.add_argument("--mode", choices=("deterministic", "bench"), default="deterministic",
                     help="deterministic (batch budget: decisions compared) or bench (the "
                     "benchmark's time budget: decisions may differ with the load; timing only)")
