@@ -28,6 +28,17 @@ def test_unicycle_motion_matches_contract_formulas(x0, y0, th, v, om, t):
     assert y == pytest.approx(ey, abs=1e-9)
 
 
+@settings(max_examples=200, deadline=None)
+@given(x0=st.floats(-1e3, 1e3), y0=st.floats(-1e3, 1e3), th=st.floats(-7, 7),
+       v=st.floats(-3, 3), om=st.just(0.0) | st.floats(-2, 2), t0=st.floats(-5, 5),
+       t=st.floats(-10, 1e3))
+def test_unicycle_position_is_positions_bit_for_bit(x0, y0, th, v, om, t0, t):
+    # position() has its own scalar path for straight motions; the simulator and the
+    # filters mix it with positions(), so the two must agree exactly, not approximately
+    m = UnicycleMotion(x0, y0, th, v, om, start_time=t0)
+    assert m.position(t).tolist() == m.positions(np.array([t]))[0].tolist()
+
+
 def test_tiny_turn_rate_is_continuous_with_the_straight_line():
     t = np.linspace(0.0, 50.0, 11)
     straight = UnicycleMotion(1.0, 2.0, 0.3, 0.5, 0.0).positions(t)

@@ -19,7 +19,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from anyplan.prediction.base import PredictedObstacle
-from anyplan.world.motion import UnicycleMotion
 
 __all__ = ["Trap", "first_trap", "reach_m"]
 
@@ -47,13 +46,9 @@ def reach_m(speed: float, v_max: float, a_max: float, tau: np.ndarray) -> np.nda
 
 
 def _centre(o: PredictedObstacle, t: float) -> tuple[float, float]:
-    """The predicted centre [m] at ``t`` [s]; in closed form on a straight line (a filter's
-    input: the same point as ``positions`` up to rounding, far below its 1 um of slack)."""
-    m = o.motion
-    if isinstance(m, UnicycleMotion) and m.omega == 0.0:
-        run = m.v * max(t - m.start_time, 0.0)
-        return m.x0 + run * math.cos(m.theta0), m.y0 + run * math.sin(m.theta0)
-    q = np.asarray(o.positions(np.array([t])), dtype=float)[0]
+    """The predicted centre [m] at ``t`` [s] (a straight motion's in scalars:
+    :meth:`UnicycleMotion.position <anyplan.world.motion.UnicycleMotion.position>`)."""
+    q = o.motion.position(t)
     return float(q[0]), float(q[1])
 
 

@@ -127,6 +127,15 @@ class UnicycleMotion(Motion):
         out[:, 1] = (self.y0 + chord * np.sin(th)).ravel()
         return out
 
+    def position(self, t: float) -> np.ndarray:
+        if self.omega != 0.0:
+            return super().position(t)
+        # a straight motion in scalars: the operations of positions(), the same bits, without
+        # its arrays (one position per step and mover in the simulator, per disc in filters)
+        c, sn, one = _straight_factors(self.theta0)
+        chord = self.v * max(float(t) - self.start_time, 0.0) * one
+        return np.array([self.x0 + chord * c, self.y0 + chord * sn])
+
     def state(self, t: float) -> tuple[float, float, float, float, float]:
         moving = t >= self.start_time
         tau = max(t - self.start_time, 0.0)
