@@ -52,7 +52,7 @@ def test_a_motion_to_the_goal_is_checked_until_it_arrives():
 
     guard = SafetyGuard(SPEC, ROOM)
     _, motion = _cruising()
-    goal, reach = np.asarray(SPEC.goal), 0.5 * SPEC.goal_tolerance
+    goal, reach = np.asarray(SPEC.goal), SPEC.arrival_radius
     ts = np.linspace(0.0, float(motion.t_end), 20001)
     inside = np.hypot(*(motion.positions(ts) - goal).T) <= reach
     first = float(ts[np.argmax(inside)])

@@ -558,7 +558,7 @@ def test_a_motion_is_checked_until_it_arrives_at_the_goal():
     ts = np.linspace(0.0, float(motion.t_end), 2001)
     d = np.hypot(*(motion.positions(ts) - goal).T)
     t_arrive = agent.guard.arrival(motion, 0.0)
-    first_in = float(ts[np.argmax(d <= 0.5 * agent.spec.goal_tolerance)])
+    first_in = float(ts[np.argmax(d <= agent.spec.arrival_radius)])
     assert first_in - 1e-9 <= t_arrive <= first_in + 0.02  # on 20 ms samples
     assert t_arrive < float(motion.t_end)
     away = plan_motion(np.array([[9.8, 3.0], [9.8, 5.0]]), agent.spec, state, agent.obstacles, 0.0)

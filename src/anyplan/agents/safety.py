@@ -173,11 +173,12 @@ class SafetyGuard:
                                margin=margin, sample_dt=self.config.sample_dt)
 
     def arrival(self, motion: Any, t: float) -> float:
-        """When ``motion`` arrives within half the goal tolerance of the goal, where the run is
-        over: the first of its samples from ``t`` [s] there (every 20 ms, or 4000 samples over a
-        longer motion), never before the true arrival; inf if it does not end there."""
+        """When ``motion`` arrives within the robot's ``arrival_radius`` of the goal (half the
+        goal tolerance), where the run is over: the first of its samples from ``t`` [s] there
+        (every 20 ms, or 4000 samples over a longer motion), never before the true arrival; inf
+        if it does not end there."""
         goal = np.asarray(self.spec.goal, dtype=float)
-        reach = 0.5 * self.spec.goal_tolerance
+        reach = self.spec.arrival_radius
         t_end = float(motion.t_end)
         if t_end < t or math.hypot(*(motion.positions(np.array([t_end]))[0] - goal)) > reach:
             return math.inf

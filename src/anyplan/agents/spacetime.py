@@ -338,7 +338,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
                 self._cands.append((nominal.t_end, nominal, np.asarray(path), list(shapes)))
                 return nominal
             res = retime(nominal, self._preds, spec, margin=cfg.margin, max_wait_s=wait,
-                         target_dt=self.lattice_dt_s, free_tail_m=0.5 * spec.goal_tolerance,
+                         target_dt=self.lattice_dt_s, free_tail_m=spec.arrival_radius,
                          rows=self._rows)
             tr = res.trajectory
             if tr is None:
@@ -380,12 +380,12 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         return min(self._cands, key=lambda c: c[0])
 
     def _tail_time(self, tr: Trajectory) -> float:
-        """Time [s] the motion spends inside half the goal tolerance at its end (run over)."""
+        """Time [s] the motion spends inside ``spec.arrival_radius`` at its end (run over)."""
         seg = tr.segments[-1]
         plan = getattr(seg, "plan", None)
         if plan is None:
             return 0.0
-        s_in = plan.s[-1] - 0.5 * self.spec.goal_tolerance
+        s_in = plan.s[-1] - self.spec.arrival_radius
         i = int(np.searchsorted(plan.s, s_in))
         return max(0.0, float(plan.t[-1] - plan.t[min(i, len(plan.t) - 1)]))
 
@@ -578,7 +578,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             return
         t_until = min(max(traj.t_end, t) + 1.0, t + _CHECK_HORIZON_S)
         end = traj.positions(np.array([traj.t_end]))[0]
-        if math.hypot(end[0] - spec.goal[0], end[1] - spec.goal[1]) <= 0.5 * spec.goal_tolerance:
+        if math.hypot(end[0] - spec.goal[0], end[1] - spec.goal[1]) <= spec.arrival_radius:
             # the run is over inside the goal tolerance: checked as planned (_timed_fn), and
             # as the guard checks it (until arrival)
             t_until = min(traj.t_end - self._tail_time(traj), self.guard.arrival(traj, t))

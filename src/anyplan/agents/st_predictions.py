@@ -134,6 +134,6 @@ class PlanningPredictions:
         to_goal = math.hypot(spec.goal[0] - state.x, spec.goal[1] - state.y)
         trap = first_trap(preds, (state.x, state.y), state.v, t, spec.radius, spec.v_max,
                           spec.a_max, self.config.margin, _TRAP_HORIZON_S,
-                          reach_cap_m=to_goal - 0.5 * spec.goal_tolerance)
+                          reach_cap_m=to_goal - spec.arrival_radius)
         self.record.st_trapped += trap is not None
         return trap is not None

@@ -57,6 +57,13 @@ class RobotSpec:
     sensing_range: float | None = None
 
     @property
+    def arrival_radius(self) -> float:
+        """Distance [m] from the goal within which a planned motion counts as arrived: half
+        the goal tolerance (the run ends within the whole of it; the other half absorbs the
+        tracking error). Checks of a motion that ends at the goal stop there."""
+        return 0.5 * self.goal_tolerance
+
+    @property
     def limits(self) -> RobotLimits:
         """The robot's size and dynamic limits as one record (e.g. for a planner's settings)."""
         return RobotLimits(self.radius, self.v_max, self.omega_max, self.a_max, self.alpha_max)
