@@ -133,6 +133,24 @@ def test_already_at_goal_holds():
     assert tr.kind == "hold" and tr.length == 0.0
 
 
+@pytest.mark.parametrize(("v0", "w0"), [(0.0, 0.3), (0.0, -0.4), (0.3, 0.2)])
+def test_already_at_goal_comes_to_rest_without_turning_back(v0, w0, limits_checker):
+    # A robot on its goal, still driving or spinning: it brakes and stops its turn where the
+    # deceleration leaves it (come_to_rest), not back at the heading it had.
+    spec = load_scenario("paper-1").robot
+    st = RobotState(3.0, 3.0, 0.5, v0, w0)
+    tr = plan_motion(np.array([[3.0, 3.0]]), spec, st, ObstacleSet(), 0.0)
+    assert tr.kind == "hold"
+    limits_checker(tr, spec)
+    _, _, th, v, w = tr.sample(np.linspace(0.0, tr.t_end, 200))
+    assert v[-1] == 0.0 and w[-1] == 0.0
+    # the heading moves one way only: the spin decelerates, it never reverses
+    dth = np.diff(th)
+    assert np.all(dth * np.sign(w0) >= -1e-12)
+    if v0 == 0.0:
+        assert th[-1] - 0.5 == pytest.approx(w0 * abs(w0) / (2.0 * spec.alpha_max), abs=1e-9)
+
+
 @pytest.mark.parametrize("v0", [0.0, 0.2, 0.4])
 def test_facing_a_wall_brakes_and_turns(v0, limits_checker):
     # Heading into a wall 0.6 m away: a smooth start would have to loop through the wall.

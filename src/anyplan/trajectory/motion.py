@@ -240,12 +240,13 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
     else:
         pts = np.vstack([p0, pts])
     if len(pts) < 2:
-        # Nothing to drive: brake (if moving) and stay.
-        brake, _ = _brake(state, spec, obstacles, radius, t_start)
-        seg: Segment = brake if brake is not None else TurnSegment(
-            state.x, state.y, rotation_profile(state.theta, 0.0, spec.omega_max, spec.alpha_max,
-                                               state.omega), t_start)
-        return Trajectory([seg], kind=MotionKind.HOLD, lower_bound_s=0.0, polyline=pts)
+        # Nothing to drive: come to rest where the robot is (a turn in place stops where the
+        # spin ends, as come_to_rest stops it; it does not turn back to the heading it had).
+        segs, _, _, _ = come_to_rest(state, spec, obstacles, radius, t_start)
+        if not segs:  # at rest: a turn by nothing holds the pose
+            segs = [TurnSegment(state.x, state.y, rotation_profile(
+                state.theta, 0.0, spec.omega_max, spec.alpha_max, 0.0), t_start)]
+        return Trajectory(segs, kind=MotionKind.HOLD, lower_bound_s=0.0, polyline=pts)
     v0 = max(state.v, 0.0)
     cands: list[tuple[bool, float, Trajectory]] = []
     info: dict = {"candidates": {}, "input_vertices": n_input, "vertices": len(pts)}
