@@ -6,7 +6,9 @@ docs/perception.md), for every planner and peer on the same seeds:
 * ``dynabarn``: DynaBARN medium + hard worlds (20-59; ``--worlds`` selects);
 * ``crowds``: the recorded ETH Hotel and UCY Zara 01 crowds cut into 40 s windows, a robot crossing
   each (``anyplan import-crowd``), and a dense variant (Zara 01 overlaid 10 times, ~30 people in
-  view on average, up to ~55), always ``tracked``;
+  view on average, up to ~55), ``tracked`` unless ``--crowd-modes`` says otherwise (``twist``:
+  each person's current position and velocity, exact; ``oracle``: their recorded future too,
+  the bound a prediction could approach);
 * ``gaps``: spacetime's gap worlds with detection noise (``tracked``);
 * ``prediction``: ADE/FDE on ETH/UCY (8 frames observed, 12 predicted, 2.5 Hz) of our tracker
   against the constant-velocity baseline, and the coverage of the uncertainty radius; and the
@@ -22,6 +24,7 @@ Usage::
 
     python benchmarks/unknown.py [--only dynabarn,crowds,gaps,prediction] [--modes twist,tracked]
         [--planners st-bitstar,seq-bitstar,dovs,orca] [--worlds 20-59] [--windows 9] [--seeds 1]
+        [--crowd-modes tracked,twist,oracle] [--sensor-noise M] [--sensor-rate HZ]
         [--jobs 2] [--set [PLANNER:]KEY=VALUE ...] [--deterministic] [--tracker KEY=VALUE ...]
 
 ``--set`` and ``--deterministic`` are ``anyplan bench``'s (agent settings; a fixed planning delay
@@ -49,14 +52,17 @@ if not SHARED.is_dir():
 
 
 def _run(task: tuple[str, dict[str, Any], str, str, int, dict[str, Any],
-                     tuple[tuple[str, float], ...]]) -> dict[str, Any]:
+                     tuple[tuple[str, float], ...], tuple[float | None, float | None]]
+         ) -> dict[str, Any]:
     from anyplan.agents import make_agent
     from anyplan.simulation import SimConfig, simulate
     from anyplan.simulation.perception import override_sensing
     from anyplan.world.scenario import scenario_from_dict
 
-    suite, data, planner, mode, seed, config, tracker = task
-    sc = override_sensing(scenario_from_dict(data, f"<{data['name']}>"), mode)
+    suite, data, planner, mode, seed, config, tracker, (noise_m, rate_hz) = task
+    sc = scenario_from_dict(data, f"<{data['name']}>")
+    sc = override_sensing(sc, mode, noise_m if mode == "tracked" else None,
+                          rate_hz if mode == "tracked" else None)
     try:
         res = simulate(sc, make_agent(planner, **config), seed=seed, config=SimConfig(tracker=tracker))
     except Exception as exc:  # noqa: BLE001 - a planner failure is a result, reported
@@ -209,9 +215,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--planners", default="st-bitstar,seq-bitstar,dovs,orca")
     ap.add_argument("--worlds", default="20-59", help="DynaBARN world indices, e.g. 20-59 or 20,25,40")
     ap.add_argument("--windows", type=int, default=100, help="crowd windows per scene (and dense)")
+    ap.add_argument("--crowd-modes", default="tracked",
+                    help="perception modes of the crowd windows (as imported: tracked)")
     ap.add_argument("--gaps", type=int, default=10, help="gap worlds")
     ap.add_argument("--seeds", type=int, default=1)
     ap.add_argument("--first-seed", type=int, default=0, help="seeds first-seed .. first-seed + seeds - 1")
+    ap.add_argument("--sensor-noise", type=float, default=None, metavar="M",
+                    help="detection noise [m] (sigma) of every tracked run (default: the scenario's)")
+    ap.add_argument("--sensor-rate", type=float, default=None, metavar="HZ",
+                    help="detection rate [Hz] of every tracked run (default: the scenario's)")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=None, help="also write the Markdown report here")
     ap.add_argument("--rows", default=None, help="also write every run's row as JSON here")
@@ -230,8 +242,16 @@ def main(argv: list[str] | None = None) -> int:
     from anyplan.agents.base import AGENTS
     from anyplan.experiments.dynabarn import parse_worlds
 
+    if (a.sensor_noise is not None and not a.sensor_noise >= 0.0) or (
+            a.sensor_rate is not None and not a.sensor_rate > 0.0):
+        ap.error("--sensor-noise must be >= 0 and --sensor-rate > 0")
+    sensing = (a.sensor_noise, a.sensor_rate)
     only = set(a.only.split(","))
     modes = a.modes.split(",")
+    crowd_modes = a.crowd_modes.split(",")
+    for m in modes + crowd_modes:
+        if m not in ("oracle", "twist", "tracked"):
+            ap.error(f"unknown perception mode {m!r} (oracle, twist or tracked)")
     planners = []
     for p in a.planners.split(","):
         try:
@@ -257,14 +277,16 @@ def main(argv: list[str] | None = None) -> int:
     seeds = range(a.first_seed, a.first_seed + a.seeds)
     if "dynabarn" in only:
         for d in _dynabarn(parse_worlds(a.worlds)):
-            tasks += [("dynabarn", d, p, m, s, configs[p], tracker) for m in modes for p in planners
-                      for s in seeds]
+            tasks += [("dynabarn", d, p, m, s, configs[p], tracker, sensing) for m in modes
+                      for p in planners for s in seeds]
     if "crowds" in only:
         for tag, d in _crowds(a.windows):
-            tasks += [(tag, d, p, "tracked", s, configs[p], tracker) for p in planners for s in seeds]
+            tasks += [(tag, d, p, m, s, configs[p], tracker, sensing) for m in crowd_modes
+                      for p in planners for s in seeds]
     if "gaps" in only:
         for d in _gaps(a.gaps):
-            tasks += [("gaps", d, p, "tracked", s, configs[p], tracker) for p in planners for s in seeds]
+            tasks += [("gaps", d, p, "tracked", s, configs[p], tracker, sensing) for p in planners
+                      for s in seeds]
     rows = []
     t0 = time.perf_counter()
     if tasks:
