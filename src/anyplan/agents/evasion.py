@@ -18,7 +18,7 @@ import numpy as np
 from anyplan.agents.safety import Escape, SafetyGuard
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.prediction.base import PredictedObstacle
-from anyplan.prediction.collision import PredictedCollision, first_collision
+from anyplan.prediction.collision import PredictedCollision, first_collision, predict_collisions
 from anyplan.trajectory.kinds import MotionKind
 from anyplan.trajectory.motion import plan_motion, polyline_trajectory, swerve_trajectory
 from anyplan.world.robot import RobotSpec, RobotState
@@ -106,10 +106,12 @@ def approach_speed(tr: Any, hit: PredictedCollision | None) -> float:
     if n < 1e-9:
         return 0.0
     a = 0.0
-    # at contact and just after it (a robot that sets off at the contact drives into it too)
-    for dt in _AFTER_CONTACT_S:
-        st = tr.state(min(float(hit.t) + dt, max(float(tr.t_end), float(hit.t))))
-        a = max(a, st.v * (math.cos(st.theta) * u[0] + math.sin(st.theta) * u[1]) / n)
+    # at contact and just after it (a robot that sets off at the contact drives into it too),
+    # the four states in one sample
+    end = max(float(tr.t_end), float(hit.t))
+    _, _, th, v, _ = tr.sample(np.array([min(float(hit.t) + dt, end) for dt in _AFTER_CONTACT_S]))
+    for th_k, v_k in zip(th.tolist(), v.tolist(), strict=True):
+        a = max(a, v_k * (math.cos(th_k) * u[0] + math.sin(th_k) * u[1]) / n)
     return a if a > APPROACH_TOL else 0.0
 
 
@@ -150,7 +152,8 @@ class FallbackRanker:
         whose escape is at rest soonest); free over the horizon against the
         full discs; then free over it against the ``planned`` (capped) discs; then, when the
         planned discs strike it within :attr:`react_s`, met at rest or moving away rather than
-        driving into the obstacle (:func:`approach_speed`); then the latest first contact
+        driving into the obstacle, and into every other obstacle met within that time
+        (:meth:`_approach`); then the latest first contact
         against the planned discs; then not a swerve (a swerve wins on none of these ties:
         a robot with nothing to escape does not set off on an arc); then the largest
         clearance against the full discs. A hold
@@ -200,9 +203,24 @@ class FallbackRanker:
             clear_ok = clear >= cfg.margin
         near = hit is not None and float(hit.t) - t < self.react_s
         return (bool(getattr(tr, "certified_free", True)), passive, clear_ok,
-                hit is None, -approach_speed(tr, hit) if near else 0.0,
+                hit is None, -self._approach(tr, t, hit, planned) if near else 0.0,
                 math.inf if hit is None else float(hit.t),
                 getattr(tr, "kind", None) != MotionKind.SWERVE), clear, h
+
+    def _approach(self, tr: Any, t: float, hit: Any, planned: Sequence[PredictedObstacle]
+                  ) -> float:
+        """The largest of the robot's approach speeds [m/s] (:func:`approach_speed`) at the
+        first contact ``hit`` and at the first contact with every other obstacle that
+        ``planned`` predicts on ``tr`` within :attr:`react_s` of ``t`` [s]. Not the first
+        contact's alone: in a crowd one person may graze every candidate first (within the
+        margin) while a swerve then drives into another who stands in its way (UCY zara01,
+        dense overlay, window 11, ``oracle``, seed 2: the robot drove into a standing person
+        it knew of, ranked by its approach to the one who grazed it)."""
+        cfg = self.guard.config
+        hits = predict_collisions(tr, planned, self.spec.radius, t_from=t, t_until=t + self.react_s,
+                                  margin=cfg.margin, sample_dt=cfg.sample_dt)
+        return max([approach_speed(tr, hit),
+                    *(approach_speed(tr, c) for c in hits if c.obstacle != hit.obstacle)])
 
     def _struck_within_margin(self, tr: Any, hit: PredictedCollision,
                               full: Sequence[PredictedObstacle]) -> bool:
