@@ -201,14 +201,16 @@ class FallbackRanker:
         else:
             clear = guard.clearance(tr, full, t, h)
             clear_ok = clear >= cfg.margin
-        near = hit is not None and float(hit.t) - t < self.react_s
+        # the approach speed counts only for a contact within the reaction time
+        approach = (self._approach(tr, t, hit, planned)
+                    if hit is not None and float(hit.t) - t < self.react_s else 0.0)
         return (bool(getattr(tr, "certified_free", True)), passive, clear_ok,
-                hit is None, -self._approach(tr, t, hit, planned) if near else 0.0,
+                hit is None, -approach,
                 math.inf if hit is None else float(hit.t),
                 getattr(tr, "kind", None) != MotionKind.SWERVE), clear, h
 
-    def _approach(self, tr: Any, t: float, hit: Any, planned: Sequence[PredictedObstacle]
-                  ) -> float:
+    def _approach(self, tr: Any, t: float, hit: PredictedCollision,
+                  planned: Sequence[PredictedObstacle]) -> float:
         """The largest of the robot's approach speeds [m/s] (:func:`approach_speed`) at the
         first contact ``hit`` and at the first contact with every other obstacle that
         ``planned`` predicts on ``tr`` within :attr:`react_s` of ``t`` [s]. Not the first
