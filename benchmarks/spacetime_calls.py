@@ -185,6 +185,8 @@ def driver(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from anyplan.world.sensing import MODES
+
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--trees", default=None, help="comma-separated source trees (before,after)")
     ap.add_argument("--reps", type=int, default=3)
@@ -193,7 +195,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--gaps", type=int, default=6)
     ap.add_argument("--dynabarn", type=int, default=0, help="DynaBARN worlds of 20-59 (default 0)")
     ap.add_argument("--worlds-file", default="/work/shared/benchmarks/dynabarn/worlds.json")
-    ap.add_argument("--dynabarn-mode", choices=("oracle", "twist", "tracked"), default="oracle",
+    ap.add_argument("--dynabarn-mode", choices=MODES, default="oracle",
                     help="perception of the DynaBARN worlds (default oracle: tracks announced)")
     ap.add_argument("--crowds", type=int, default=0,
                     help="windows of each recorded crowd and of the dense overlay (default 0)")

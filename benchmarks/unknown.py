@@ -241,17 +241,18 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(str(exc))
     from anyplan.agents.base import AGENTS
     from anyplan.experiments.dynabarn import parse_worlds
+    from anyplan.world.sensing import DEFAULT_NOISE_M, DEFAULT_RATE_HZ, SensingError, SensingSpec
 
-    if (a.sensor_noise is not None and not a.sensor_noise >= 0.0) or (
-            a.sensor_rate is not None and not a.sensor_rate > 0.0):
-        ap.error("--sensor-noise must be >= 0 and --sensor-rate > 0")
     sensing = (a.sensor_noise, a.sensor_rate)
     only = set(a.only.split(","))
     modes = a.modes.split(",")
     crowd_modes = a.crowd_modes.split(",")
-    for m in modes + crowd_modes:
-        if m not in ("oracle", "twist", "tracked"):
-            ap.error(f"unknown perception mode {m!r} (oracle, twist or tracked)")
+    try:  # the scenario schema's own checks of a mode, a noise and a rate, before any run
+        for m in modes + crowd_modes:
+            SensingSpec(m, DEFAULT_NOISE_M if a.sensor_noise is None else a.sensor_noise,
+                        DEFAULT_RATE_HZ if a.sensor_rate is None else a.sensor_rate)
+    except SensingError as exc:
+        ap.error(str(exc))
     planners = []
     for p in a.planners.split(","):
         try:

@@ -45,13 +45,6 @@ def reach_m(speed: float, v_max: float, a_max: float, tau: np.ndarray) -> np.nda
     return np.where(tau <= t_top, ramp, top)
 
 
-def _centre(o: PredictedObstacle, t: float) -> tuple[float, float]:
-    """The predicted centre [m] at ``t`` [s] (a straight motion's in scalars:
-    :meth:`UnicycleMotion.position <anyplan.world.motion.UnicycleMotion.position>`)."""
-    q = o.motion.position(t)
-    return float(q[0]), float(q[1])
-
-
 @dataclass(frozen=True)
 class Trap:
     """The first time ``t`` [s] at which ``obstacle``'s disc holds every place the robot can be."""
@@ -103,7 +96,7 @@ def first_trap(preds: Sequence[PredictedObstacle], position: tuple[float, float]
     best: Trap | None = None
     for o in preds:
         # the disc must come within `widest` of the robot while its reach is that small
-        qx, qy = _centre(o, t0)
+        qx, qy = o.motion.position(t0)  # a straight motion's in scalars
         if math.hypot(qx - p[0], qy - p[1]) - float(o.max_speed) * float(tau[-1]) >= widest + 1e-6:
             continue
         q = np.asarray(o.positions(t), dtype=float).reshape(-1, 2)

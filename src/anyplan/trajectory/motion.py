@@ -125,9 +125,9 @@ def swerve_trajectory(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet
                        spec.a_max, spec.alpha_max, t0, duration)
     free = _table_free(sw, obstacles, radius)
     end = sw.sample(np.array([sw.t1]))
-    rest, _, _, brake_free = come_to_rest(RobotState(*(float(a[0]) for a in end)), spec,
+    tail, _, _, brake_free = come_to_rest(RobotState(*(float(a[0]) for a in end)), spec,
                                           obstacles, radius, sw.t1)
-    segs: list[Segment] = [sw, *rest]
+    segs: list[Segment] = [sw, *tail]
     length = float(sum(s.length for s in segs))
     return Trajectory(segs, kind=MotionKind.SWERVE,
                       lower_bound_s=time_lower_bound(length, spec, abs(state.v)),
