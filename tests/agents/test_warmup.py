@@ -112,7 +112,8 @@ def no_parts_loaded(monkeypatch):
 
 def test_second_process_takes_the_motion_part_only_when_another_part_stays_here(no_parts_loaded):
     wu = no_parts_loaded
-    assert wu.prefetch_parts(PARTS) == ("motion", "contacts")
+    # in the order the second process compiles them: the clearance kernels come last
+    assert wu.prefetch_parts(PARTS) == ("contacts", "motion")
     assert wu.prefetch_parts(("bitstar", "motion")) == ("motion",)
     assert wu.prefetch_parts(("motion", "contacts")) == ()  # this process would only wait
     assert wu.prefetch_parts(("bitstar",)) == ()
@@ -205,3 +206,32 @@ def test_stmap_part_loads_no_kernel_of_the_motion_part():
                                                "anyplan.trajectory._path"))]
     assert motion == []
     assert PARTS.index("stmap") < PARTS.index("motion")
+
+
+def test_motion_part_compiles_its_curve_kernels_before_any_clearance_kernel():
+    """A second process compiling the motion part on a cold cache starts with the kernels that
+    query no obstacle (``_curves``), so that it meets the clearance kernels only once this
+    process, which compiles them first (scenario loading, BIT*), has put them in the cache."""
+    import subprocess
+    import sys
+
+    probe = (
+        "import sys\n"
+        "import numpy as np\n"
+        "import anyplan.agents.warmup as wu\n"
+        "obs, spec = wu._scene()\n"
+        "wu._curves(spec, np.array([[0.5, 0.5], [3.0, 1.2], [3.5, 3.5]]))\n"
+        "from numba.core.registry import CPUDispatcher\n"
+        "used = set()\n"
+        "for name, mod in list(sys.modules.items()):\n"
+        "    if name.startswith('anyplan.'):\n"
+        "        for attr in vars(mod).values():\n"
+        "            if isinstance(attr, CPUDispatcher) and attr.signatures:\n"
+        "                used.add(attr.py_func.__module__)\n"
+        "print(' '.join(sorted(used)))\n")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         timeout=600, check=True)
+    used = out.stdout.split()
+    assert {"anyplan.trajectory.spline._fit", "anyplan.trajectory.profile",
+            "anyplan.trajectory.spline._drive"} <= set(used)
+    assert not [m for m in used if m.startswith("anyplan.geometry")]

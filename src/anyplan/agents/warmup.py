@@ -28,6 +28,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from anyplan.world.robot import RobotSpec
+
 __all__ = ["warm_up_kernels", "PARTS", "compiling_notifier", "prefetch_kernels", "prefetch_parts",
            "prefetch_report"]
 
@@ -36,9 +39,10 @@ logger = logging.getLogger(__name__)
 PARTS = ("bitstar", "stmap", "motion", "contacts", "sequential", "spacetime")
 _DONE: set[str] = set()
 #: A part that a second process may compile while this one compiles the others: it shares no
-#: kernel with loading a scenario, the time lower bound or BIT*'s part (``sequential`` runs
-#: BIT* and the motion planner, so it would compile both again).
-PREFETCHABLE = ("motion", "contacts")
+#: kernel with loading a scenario, the time lower bound or BIT*'s part but the clearance
+#: kernels (``sequential`` runs BIT* and the motion planner, so it would compile both again).
+#: The second process compiles them in this order, the clearance kernels last (:func:`_curves`).
+PREFETCHABLE = ("contacts", "motion")
 #: Set to ``1`` (or ``0``) to compile in this process only.
 ENV_JOBS = "ANYPLAN_COMPILE_JOBS"
 
@@ -152,10 +156,10 @@ _PREFETCH: dict[str, _Prefetch] = {}
 def prefetch_parts(parts: Iterable[str]) -> tuple[str, ...]:
     """The parts of ``parts`` that :func:`prefetch_kernels` would hand to a second process: the
     prefetchable ones, when another part stays for this process and this process has not
-    loaded them yet."""
+    loaded them yet, in :data:`PREFETCHABLE`'s order."""
     parts = tuple(parts)
     mine = [p for p in parts if p not in PREFETCHABLE]
-    return tuple(p for p in parts if p in PREFETCHABLE and p not in _DONE and p not in _PREFETCH
+    return tuple(p for p in PREFETCHABLE if p in parts and p not in _DONE and p not in _PREFETCH
                  and mine)
 
 
@@ -200,7 +204,8 @@ def _stop_prefetch() -> None:
 def _child() -> None:
     """The second process: compile ``sys.argv[1:]``, print what it compiled as one JSON line."""
     with compiling_notifier(None) as note:
-        warm_up_kernels(sys.argv[1:])
+        for part in sys.argv[1:]:  # in the order given (PREFETCHABLE's), not PARTS'
+            warm_up_kernels([part])
     print(json.dumps({"count": note.count, "seconds": note.seconds}))
 
 
@@ -222,6 +227,28 @@ def _scene():  # noqa: ANN202 - small fixture shared by the motion and sequentia
     return obs, spec
 
 
+def _curves(spec: RobotSpec, path: np.ndarray) -> None:
+    """The motion part's kernels that query no obstacle (the spline, its regularity, speed
+    profile and sampling; turning in place): compiled first, so that a second process compiling
+    the motion part reaches the clearance kernels it shares with this one's scenario loading and
+    BIT* after them, and loads them from the cache instead of compiling them again."""
+    from anyplan.trajectory.motion import turn_segment
+    from anyplan.trajectory.path import clean_path
+    from anyplan.trajectory.profile import time_parameterize
+    from anyplan.trajectory.spline import SmoothCurve
+    from anyplan.trajectory.trajectory import CurveSegment, Trajectory
+
+    pts = clean_path(path)
+    for heading, kappa, v0 in ((0.0, None, 0.0), (0.3, 0.5, 0.2)):  # _motion's two states
+        curve = SmoothCurve(pts, start_heading=heading, grid_step=0.05, start_curvature=kappa)
+        curve.is_regular()
+        curve.curvature(np.array([0.0]))
+        traj = Trajectory([CurveSegment(curve, time_parameterize(curve, spec, v0), 0.0)])
+        traj.sample(np.array([0.5]))
+        traj.sample(np.linspace(0.0, traj.t_end, 7))
+    turn_segment(0.5, 0.5, 0.0, 1.0, spec, 0.0).sample(np.array([0.1]))
+
+
 def _motion() -> None:
     """Smoothing, certification, speed profile and sampling of a motion."""
     from anyplan.trajectory.motion import plan_motion
@@ -229,6 +256,7 @@ def _motion() -> None:
 
     obs, spec = _scene()
     path = np.array([[0.5, 0.5], [3.0, 1.2], [3.5, 3.5]])
+    _curves(spec, path)
     for state in (RobotState(0.5, 0.5, 0.0), RobotState(0.5, 0.5, 0.3, 0.2, 0.1)):
         traj = plan_motion(path, spec, state, obs, 0.0, margin=0.015, grid_step=0.05)
         traj.sample(np.array([0.5]))

@@ -463,93 +463,46 @@ def capsule_buried(ax: float, ay: float, bx: float, by: float, pad: float,
     return False
 
 
-@njit(cache=True, inline="always")
-def points_clearance(px: np.ndarray, py: np.ndarray, obs: ObstacleArrays) -> np.ndarray:
-    """Vectorised :func:`point_clearance`, shape (N,)."""
-    out = np.empty(px.shape[0])
-    for n in range(px.shape[0]):
-        out[n] = point_clearance(px[n], py[n], obs)
-    return out
-
-
-@njit(cache=True, inline="always")
-def points_clear(px: np.ndarray, py: np.ndarray, obs: ObstacleArrays, limit: float) -> np.ndarray:
-    """Mask (N,): the exact clearance of each point is >= ``limit`` [m] (pass/fail only)."""
-    out = np.empty(px.shape[0], dtype=np.bool_)
-    for n in range(px.shape[0]):
-        out[n] = _segment_clearance(px[n], py[n], px[n], py[n], obs, limit, np.bool_(False),
-                                    INF) >= limit
-    return out
-
-
-@njit(cache=True, inline="always")
-def segments_clearance(ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray,
-                       obs: ObstacleArrays, stop_below: float) -> np.ndarray:
-    """Vectorised :func:`segment_clearance`, shape (N,)."""
-    out = np.empty(ax.shape[0])
-    for n in range(ax.shape[0]):
-        out[n] = segment_clearance(ax[n], ay[n], bx[n], by[n], obs, stop_below)
-    return out
-
-
 # --- entries for calls from Python ---------------------------------------------------------
 # numba types a NamedTuple argument from Python on its slow path (about 2 us per call more
 # than eight arrays), so ObstacleSet's methods pass the record's fields and the record is
-# rebuilt here, in compiled code, for free. Compiled callers pass the record itself.
+# rebuilt here, in compiled code, for free. Compiled callers pass the record itself. Two
+# entries serve every query kind: numba links the whole clearance chain into each entry and
+# generates its machine code again there, so each entry more costs a cold start about 0.4 s.
 
-@njit(cache=True)
-def py_point_clearance(px: float, py: float, vx: np.ndarray, vy: np.ndarray, starts: np.ndarray,
-                       pbox: np.ndarray, circles: np.ndarray, bounds: np.ndarray,
-                       gmeta: np.ndarray, gcsr: np.ndarray) -> float:
-    """:func:`point_clearance` of the record made of the given fields."""
-    return point_clearance(px, py, ObstacleArrays(vx, vy, starts, pbox, circles, bounds, gmeta,
-                                                  gcsr))
+#: Query kinds of :func:`py_query` and :func:`py_queries`: the clearance of point a; the
+#: clearance of segment ab (early exit below ``arg``, as :func:`segment_clearance`); the
+#: pass/fail value of ab at the limit ``arg`` (compare it with ``arg``: ``< arg`` iff
+#: :func:`segment_blocked`; for a point, a == b, ``>= arg`` iff the point is clear).
+POINT, SEGMENT, PASS_FAIL = 0, 1, 2
 
 
-@njit(cache=True)
-def py_segment_clearance(ax: float, ay: float, bx: float, by: float, vx: np.ndarray,
-                         vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
-                         circles: np.ndarray, bounds: np.ndarray, gmeta: np.ndarray,
-                         gcsr: np.ndarray, stop_below: float) -> float:
-    """:func:`segment_clearance` of the record made of the given fields."""
-    return segment_clearance(ax, ay, bx, by, ObstacleArrays(vx, vy, starts, pbox, circles,
-                                                            bounds, gmeta, gcsr), stop_below)
+@njit(cache=True, inline="always")
+def _query(kind: int, ax: float, ay: float, bx: float, by: float, obs: ObstacleArrays,
+           arg: float) -> float:
+    if kind == POINT:
+        return point_clearance(ax, ay, obs)
+    return _segment_clearance(ax, ay, bx, by, obs, arg, kind == SEGMENT, INF)
 
 
 @njit(cache=True)
-def py_segment_blocked(ax: float, ay: float, bx: float, by: float, vx: np.ndarray,
-                       vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
-                       circles: np.ndarray, bounds: np.ndarray, gmeta: np.ndarray,
-                       gcsr: np.ndarray, limit: float) -> bool:
-    """:func:`segment_blocked` of the record made of the given fields."""
-    return segment_blocked(ax, ay, bx, by, ObstacleArrays(vx, vy, starts, pbox, circles, bounds,
-                                                          gmeta, gcsr), limit)
+def py_query(kind: int, ax: float, ay: float, bx: float, by: float, vx: np.ndarray,
+             vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
+             bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray, arg: float) -> float:
+    """One query of kind ``kind`` (:data:`POINT`, :data:`SEGMENT`, :data:`PASS_FAIL`) against
+    the record made of the given fields."""
+    return _query(kind, ax, ay, bx, by,
+                  ObstacleArrays(vx, vy, starts, pbox, circles, bounds, gmeta, gcsr), arg)
 
 
 @njit(cache=True)
-def py_points_clearance(px: np.ndarray, py: np.ndarray, vx: np.ndarray, vy: np.ndarray,
-                        starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
-                        bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray) -> np.ndarray:
-    """:func:`points_clearance` of the record made of the given fields."""
-    return points_clearance(px, py, ObstacleArrays(vx, vy, starts, pbox, circles, bounds, gmeta,
-                                                   gcsr))
-
-
-@njit(cache=True)
-def py_points_clear(px: np.ndarray, py: np.ndarray, vx: np.ndarray, vy: np.ndarray,
-                    starts: np.ndarray, pbox: np.ndarray, circles: np.ndarray,
-                    bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray,
-                    limit: float) -> np.ndarray:
-    """:func:`points_clear` of the record made of the given fields."""
-    return points_clear(px, py, ObstacleArrays(vx, vy, starts, pbox, circles, bounds, gmeta,
-                                               gcsr), limit)
-
-
-@njit(cache=True)
-def py_segments_clearance(ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray,
-                          vx: np.ndarray, vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
-                          circles: np.ndarray, bounds: np.ndarray, gmeta: np.ndarray,
-                          gcsr: np.ndarray, stop_below: float) -> np.ndarray:
-    """:func:`segments_clearance` of the record made of the given fields."""
-    return segments_clearance(ax, ay, bx, by, ObstacleArrays(vx, vy, starts, pbox, circles,
-                                                             bounds, gmeta, gcsr), stop_below)
+def py_queries(kind: int, ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray,
+               vx: np.ndarray, vy: np.ndarray, starts: np.ndarray, pbox: np.ndarray,
+               circles: np.ndarray, bounds: np.ndarray, gmeta: np.ndarray, gcsr: np.ndarray,
+               arg: float) -> np.ndarray:
+    """:func:`py_query` of each (a[n], b[n]), shape (N,)."""
+    obs = ObstacleArrays(vx, vy, starts, pbox, circles, bounds, gmeta, gcsr)
+    out = np.empty(ax.shape[0])
+    for n in range(ax.shape[0]):
+        out[n] = _query(kind, ax[n], ay[n], bx[n], by[n], obs, arg)
+    return out

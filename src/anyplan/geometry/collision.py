@@ -211,11 +211,15 @@ class ObstacleSet:
 
     # --- single queries -------------------------------------------------------------------
     # (the record's fields one by one: see the note on the py_* entries in _clearance)
+    def _query(self, kind: int, a: Sequence[float] | np.ndarray, b: Sequence[float] | np.ndarray,
+               arg: float) -> float:
+        o = self._arrays
+        return k.py_query(kind, float(a[0]), float(a[1]), float(b[0]), float(b[1]), o.vx, o.vy,
+                          o.starts, o.pbox, o.circles, o.bounds, o.gmeta, o.gcsr, arg)
+
     def clearance(self, point: Sequence[float] | np.ndarray) -> float:
         """Distance [m] from ``point`` to the nearest obstacle or wall (0 inside one)."""
-        o = self._arrays
-        return float(k.py_point_clearance(float(point[0]), float(point[1]), o.vx, o.vy, o.starts,
-                                          o.pbox, o.circles, o.bounds, o.gmeta, o.gcsr))
+        return float(self._query(k.POINT, point, point, 0.0))
 
     def point_free(self, point: Sequence[float] | np.ndarray, radius: float) -> bool:
         """True if a disc of ``radius`` [m] at ``point`` touches no obstacle and no wall."""
@@ -224,28 +228,31 @@ class ObstacleSet:
     def segment_clearance(self, a: Sequence[float] | np.ndarray,
                           b: Sequence[float] | np.ndarray) -> float:
         """Exact minimum distance [m] from segment ``ab`` to the obstacles and walls."""
-        o = self._arrays
-        return float(k.py_segment_clearance(float(a[0]), float(a[1]), float(b[0]), float(b[1]),
-                                            o.vx, o.vy, o.starts, o.pbox, o.circles, o.bounds,
-                                            o.gmeta, o.gcsr, -1.0))
+        return float(self._query(k.SEGMENT, a, b, -1.0))
 
     def segment_free(self, a: Sequence[float] | np.ndarray, b: Sequence[float] | np.ndarray,
                      radius: float) -> bool:
         """True if a disc of ``radius`` [m] moving straight from ``a`` to ``b`` touches nothing."""
-        o = self._arrays
         limit = radius - COLLISION_EPS
-        return not k.py_segment_blocked(float(a[0]), float(a[1]), float(b[0]), float(b[1]),
-                                        o.vx, o.vy, o.starts, o.pbox, o.circles, o.bounds,
-                                        o.gmeta, o.gcsr, limit)
+        return not self._query(k.PASS_FAIL, a, b, limit) < limit
 
     # --- batched queries ------------------------------------------------------------------
+    def _queries(self, kind: int, a: np.ndarray, b: np.ndarray | None, arg: float) -> np.ndarray:
+        """:meth:`_query` of each (a[n], b[n]) (b None: a), ``a``, ``b`` shape (N, 2)."""
+        o = self._arrays
+        a = np.asarray(a, dtype=float).reshape(-1, 2)
+        ax, ay = np.ascontiguousarray(a[:, 0]), np.ascontiguousarray(a[:, 1])
+        if b is None:
+            bx, by = ax, ay
+        else:
+            b = np.asarray(b, dtype=float).reshape(-1, 2)
+            bx, by = np.ascontiguousarray(b[:, 0]), np.ascontiguousarray(b[:, 1])
+        return k.py_queries(kind, ax, ay, bx, by, o.vx, o.vy, o.starts, o.pbox, o.circles,
+                            o.bounds, o.gmeta, o.gcsr, arg)
+
     def clearances(self, points: np.ndarray) -> np.ndarray:
         """Clearance of each point, ``points`` shape (N, 2), result shape (N,) [m]."""
-        o = self._arrays
-        p = np.ascontiguousarray(np.asarray(points, dtype=float).reshape(-1, 2))
-        return k.py_points_clearance(np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1]),
-                                     o.vx, o.vy, o.starts, o.pbox, o.circles, o.bounds, o.gmeta,
-                                     o.gcsr)
+        return self._queries(k.POINT, points, None, 0.0)
 
     def points_free(self, points: np.ndarray, radius: float) -> np.ndarray:
         """Boolean mask (N,): a disc of ``radius`` at each point touches nothing."""
@@ -254,30 +261,17 @@ class ObstacleSet:
     def points_clear(self, points: np.ndarray, limit: float) -> np.ndarray:
         """Boolean mask (N,): the clearance of each point is >= ``limit`` [m]; the same answer
         as ``clearances(points) >= limit``, faster on maps (it stops at ``limit``)."""
-        o = self._arrays
-        p = np.ascontiguousarray(np.asarray(points, dtype=float).reshape(-1, 2))
-        return k.py_points_clear(np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1]),
-                                 o.vx, o.vy, o.starts, o.pbox, o.circles, o.bounds, o.gmeta,
-                                 o.gcsr, float(limit))
+        limit = float(limit)
+        return self._queries(k.PASS_FAIL, points, None, limit) >= limit
 
     def segments_clearance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Exact clearance of each segment ``a[i] -> b[i]``, both shape (N, 2); result (N,)."""
-        return self._segments_clearance(a, b, -1.0)
+        return self._queries(k.SEGMENT, a, b, -1.0)
 
     def segments_free(self, a: np.ndarray, b: np.ndarray, radius: float) -> np.ndarray:
         """Boolean mask (N,): a disc of ``radius`` moving along each segment touches nothing."""
         limit = radius - COLLISION_EPS
-        return self._segments_clearance(a, b, limit) >= limit
-
-    def _segments_clearance(self, a: np.ndarray, b: np.ndarray, stop_below: float) -> np.ndarray:
-        o = self._arrays
-        a = np.asarray(a, dtype=float).reshape(-1, 2)
-        b = np.asarray(b, dtype=float).reshape(-1, 2)
-        return k.py_segments_clearance(np.ascontiguousarray(a[:, 0]),
-                                       np.ascontiguousarray(a[:, 1]),
-                                       np.ascontiguousarray(b[:, 0]),
-                                       np.ascontiguousarray(b[:, 1]), o.vx, o.vy, o.starts,
-                                       o.pbox, o.circles, o.bounds, o.gmeta, o.gcsr, stop_below)
+        return self._queries(k.SEGMENT, a, b, limit) >= limit
 
     def path_free(self, path: np.ndarray, radius: float) -> bool:
         """True if every segment of the polyline ``path`` (N, 2) is free for the disc robot."""
