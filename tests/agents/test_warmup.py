@@ -114,6 +114,9 @@ def test_second_process_takes_the_motion_part_only_when_another_part_stays_here(
     wu = no_parts_loaded
     # in the order the second process compiles them: the clearance kernels come last
     assert wu.prefetch_parts(PARTS) == ("contacts", "motion")
+    # the simulation's visibility graph first: this process checks feasibility before BIT*
+    assert wu.prefetch_parts((wu.VISGRAPH, *PARTS)) == (wu.VISGRAPH, "contacts", "motion")
+    assert wu.prefetch_parts((wu.VISGRAPH,)) == ()  # a planner without kernels: nothing to share
     assert wu.prefetch_parts(("bitstar", "motion")) == ("motion",)
     assert wu.prefetch_parts(("motion", "contacts")) == ()  # this process would only wait
     assert wu.prefetch_parts(("bitstar",)) == ()

@@ -31,18 +31,24 @@ import numpy as np
 if TYPE_CHECKING:
     from anyplan.world.robot import RobotSpec
 
-__all__ = ["warm_up_kernels", "PARTS", "compiling_notifier", "prefetch_kernels", "prefetch_parts",
-           "prefetch_report"]
+__all__ = ["warm_up_kernels", "PARTS", "VISGRAPH", "compiling_notifier", "prefetch_kernels",
+           "prefetch_parts", "prefetch_report"]
 
 logger = logging.getLogger(__name__)
-#: Every part, in the order they are loaded.
+#: Every agent's part, in the order they are loaded.
 PARTS = ("bitstar", "stmap", "motion", "contacts", "sequential", "spacetime")
+#: A part of the simulation's own, not an agent's: the visibility graph of the feasibility check
+#: before every run and of the time lower bound (a scenario without a map). Only a second
+#: process compiles it ahead (``anyplan run``); otherwise it compiles or loads on first use.
+VISGRAPH = "visgraph"
 _DONE: set[str] = set()
 #: A part that a second process may compile while this one compiles the others: it shares no
-#: kernel with loading a scenario, the time lower bound or BIT*'s part but the clearance
-#: kernels (``sequential`` runs BIT* and the motion planner, so it would compile both again).
-#: The second process compiles them in this order, the clearance kernels last (:func:`_curves`).
-PREFETCHABLE = ("contacts", "motion")
+#: kernel with loading a scenario or BIT*'s part but the clearance kernels (``sequential`` runs
+#: BIT* and the motion planner, so it would compile both again). The second process compiles
+#: them in this order, the clearance kernels last (:func:`_curves`), so that it loads those from
+#: the cache this process fills first, and this process loads the visibility graph's kernels
+#: from the cache when it checks the run's feasibility, after loading the scenario.
+PREFETCHABLE = (VISGRAPH, "contacts", "motion")
 #: Set to ``1`` (or ``0``) to compile in this process only.
 ENV_JOBS = "ANYPLAN_COMPILE_JOBS"
 
@@ -362,8 +368,16 @@ def _spacetime() -> None:
         verify(res.trajectory, [mover], spec.radius)
 
 
-_RUN = {"bitstar": _bitstar, "stmap": _stmap, "motion": _motion, "contacts": _contacts,
-        "sequential": _sequential, "spacetime": _spacetime}
+def _visgraph() -> None:
+    """The relaxed visibility graph without a map (:data:`VISGRAPH`)."""
+    from anyplan.planning.visgraph import warm_up
+
+    warm_up()
+
+
+#: Every part (the simulation's first), in the order they are loaded.
+_RUN = {VISGRAPH: _visgraph, "bitstar": _bitstar, "stmap": _stmap, "motion": _motion,
+        "contacts": _contacts, "sequential": _sequential, "spacetime": _spacetime}
 
 
 def warm_up_kernels(parts: Iterable[str] = PARTS,
@@ -374,10 +388,10 @@ def warm_up_kernels(parts: Iterable[str] = PARTS,
     Raises:
         ValueError: an unknown part.
     """
-    todo = [p for p in PARTS if p in set(parts) and p not in _DONE]
-    unknown = set(parts) - set(PARTS)
+    todo = [p for p in _RUN if p in set(parts) and p not in _DONE]
+    unknown = set(parts) - set(_RUN)
     if unknown:
-        raise ValueError(f"parts: unknown {sorted(unknown)} (known: {', '.join(PARTS)})")
+        raise ValueError(f"parts: unknown {sorted(unknown)} (known: {', '.join(_RUN)})")
     if not todo:
         return 0.0
     t0 = time.perf_counter()

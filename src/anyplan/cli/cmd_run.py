@@ -75,13 +75,14 @@ def cmd_run(args: argparse.Namespace) -> int:
     """Simulate one run and write its result and picture; say so on stderr if numba compiles
     kernels (the first run on a machine), and for how long.
 
-    On a cold cache a second process compiles the planner's motion kernels meanwhile
-    (:func:`~anyplan.agents.warmup.prefetch_kernels`; ``ANYPLAN_COMPILE_JOBS=1`` turns it off)."""
-    from anyplan.agents.warmup import compiling_notifier, prefetch_kernels, prefetch_report
+    On a cold cache a second process compiles the feasibility check's visibility graph and the
+    planner's motion kernels meanwhile (:func:`~anyplan.agents.warmup.prefetch_kernels`;
+    ``ANYPLAN_COMPILE_JOBS=1`` turns it off)."""
+    from anyplan.agents.warmup import VISGRAPH, compiling_notifier, prefetch_kernels, prefetch_report
 
     def compiling() -> None:
         _compiling_notice()
-        prefetch_kernels(_kernel_parts(args.planner))
+        prefetch_kernels((VISGRAPH, *_kernel_parts(args.planner)))
 
     with compiling_notifier(compiling) as note:
         code = _run(args)

@@ -211,15 +211,12 @@ class ObstacleSet:
 
     # --- single queries -------------------------------------------------------------------
     # (the record's fields one by one: see the note on the py_* entries in _clearance)
-    def _query(self, kind: int, a: Sequence[float] | np.ndarray, b: Sequence[float] | np.ndarray,
-               arg: float) -> float:
-        o = self._arrays
-        return k.py_query(kind, float(a[0]), float(a[1]), float(b[0]), float(b[1]), o.vx, o.vy,
-                          o.starts, o.pbox, o.circles, o.bounds, o.gmeta, o.gcsr, arg)
-
     def clearance(self, point: Sequence[float] | np.ndarray) -> float:
         """Distance [m] from ``point`` to the nearest obstacle or wall (0 inside one)."""
-        return float(self._query(k.POINT, point, point, 0.0))
+        o = self._arrays
+        x, y = float(point[0]), float(point[1])
+        return k.py_query(k.POINT, x, y, x, y, o.vx, o.vy, o.starts, o.pbox, o.circles, o.bounds,
+                          o.gmeta, o.gcsr, 0.0)
 
     def point_free(self, point: Sequence[float] | np.ndarray, radius: float) -> bool:
         """True if a disc of ``radius`` [m] at ``point`` touches no obstacle and no wall."""
@@ -228,13 +225,18 @@ class ObstacleSet:
     def segment_clearance(self, a: Sequence[float] | np.ndarray,
                           b: Sequence[float] | np.ndarray) -> float:
         """Exact minimum distance [m] from segment ``ab`` to the obstacles and walls."""
-        return float(self._query(k.SEGMENT, a, b, -1.0))
+        o = self._arrays
+        return k.py_query(k.SEGMENT, float(a[0]), float(a[1]), float(b[0]), float(b[1]), o.vx,
+                          o.vy, o.starts, o.pbox, o.circles, o.bounds, o.gmeta, o.gcsr, -1.0)
 
     def segment_free(self, a: Sequence[float] | np.ndarray, b: Sequence[float] | np.ndarray,
                      radius: float) -> bool:
         """True if a disc of ``radius`` [m] moving straight from ``a`` to ``b`` touches nothing."""
+        o = self._arrays
         limit = radius - COLLISION_EPS
-        return not self._query(k.PASS_FAIL, a, b, limit) < limit
+        return not k.py_query(k.PASS_FAIL, float(a[0]), float(a[1]), float(b[0]), float(b[1]),
+                              o.vx, o.vy, o.starts, o.pbox, o.circles, o.bounds, o.gmeta, o.gcsr,
+                              limit) < limit
 
     # --- batched queries ------------------------------------------------------------------
     def _queries(self, kind: int, a: np.ndarray, b: np.ndarray | None, arg: float) -> np.ndarray:

@@ -16,20 +16,19 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
-from anyplan.geometry.collision import ObstacleArrays, ObstacleSet, segment_blocked_kernel
+from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.shapes import Circle, Polygon
 from anyplan.planning._visgraph_boxes import convex_box_corners, corner_arcs, inscribed_radius
+from anyplan.planning._visgraph_kernels import Components, edges, edges_relaxed, points_in_any
 from anyplan.planning.base import Planner, PlanResult
 from anyplan.planning.problem import Problem
 from anyplan.planning.status import PlannerStatus
 from anyplan.planning.termination import TerminationCondition
 
-__all__ = ["VisGraphResult", "shortest_path", "lower_bound", "VisGraphPlanner"]
+__all__ = ["VisGraphResult", "shortest_path", "lower_bound", "VisGraphPlanner", "warm_up"]
 
 DEFAULT_ARC_STEP = 2.0 * math.pi / 64.0
 _EPS = 1e-9  # geometric tolerance [m] of the interior tests
@@ -212,27 +211,6 @@ def _radius(problem: Problem, variant: str) -> float:
     return problem.check_radius if variant == "feasible" else problem.radius
 
 
-class Components(NamedTuple):
-    """Convex polygons whose union is the (relaxed) inflated obstacles, for the interior
-    tests; K components, E edges in all. Produced by :func:`_pack` only."""
-
-    #: Vertex x [m], shape (E,).
-    vx: np.ndarray
-    #: Vertex y [m], shape (E,).
-    vy: np.ndarray
-    #: int64 offsets, shape (K + 1,): component k owns vertices and edges
-    #: ``starts[k]:starts[k + 1]``.
-    starts: np.ndarray
-    #: Bounding boxes (xmin, ymin, xmax, ymax) [m], shape (K, 4).
-    box: np.ndarray
-    #: Outward unit normal x of each edge, shape (E,).
-    nx: np.ndarray
-    #: Outward unit normal y of each edge, shape (E,).
-    ny: np.ndarray
-    #: Offset of each edge's line, ``nx * x + ny * y = off`` [m], shape (E,).
-    off: np.ndarray
-
-
 def _pack(comps: list[np.ndarray]) -> Components:
     """The record of the convex components ``comps`` (CCW vertex arrays)."""
     if not comps:
@@ -252,180 +230,6 @@ def _pack(comps: list[np.ndarray]) -> Components:
         off.append(ux * c[:, 0] + uy * c[:, 1])
     return Components(np.ascontiguousarray(verts[:, 0]), np.ascontiguousarray(verts[:, 1]),
                       starts, box, np.concatenate(nx), np.concatenate(ny), np.concatenate(off))
-
-
-# ------------------------------------------------------------------------------------------
-# Compiled kernels
-# ------------------------------------------------------------------------------------------
-@njit(cache=True)
-def _point_in_any(px: float, py: float, c: Components, eps: float) -> bool:
-    """True if p is in the open interior (shrunk by eps) of any convex component."""
-    starts = c.starts
-    box = c.box
-    nx = c.nx
-    ny = c.ny
-    off = c.off
-    for k in range(starts.shape[0] - 1):
-        if px <= box[k, 0] or px >= box[k, 2] or py <= box[k, 1] or py >= box[k, 3]:
-            continue
-        inside = True
-        for e in range(starts[k], starts[k + 1]):
-            if nx[e] * px + ny[e] * py >= off[e] - eps:
-                inside = False
-                break
-        if inside:
-            return True
-    return False
-
-
-@njit(cache=True)
-def _points_in_any(px: np.ndarray, py: np.ndarray, c: Components, eps: float) -> np.ndarray:
-    """Mask (N,): :func:`_point_in_any` of each point."""
-    out = np.zeros(px.shape[0], np.bool_)
-    for i in range(px.shape[0]):
-        out[i] = _point_in_any(px[i], py[i], c, eps)
-    return out
-
-
-@njit(cache=True)
-def _segment_hits_any(ax: float, ay: float, bx: float, by: float, c: Components,
-                      eps: float) -> bool:
-    """True if segment ab meets the open interior (shrunk by eps) of any convex component."""
-    starts = c.starts
-    box = c.box
-    nx = c.nx
-    ny = c.ny
-    off = c.off
-    x0 = min(ax, bx)
-    x1 = max(ax, bx)
-    y0 = min(ay, by)
-    y1 = max(ay, by)
-    dx = bx - ax
-    dy = by - ay
-    for k in range(starts.shape[0] - 1):
-        if x1 <= box[k, 0] or x0 >= box[k, 2] or y1 <= box[k, 1] or y0 >= box[k, 3]:
-            continue
-        lo = 0.0
-        hi = 1.0
-        for e in range(starts[k], starts[k + 1]):
-            den = nx[e] * dx + ny[e] * dy
-            num = off[e] - eps - (nx[e] * ax + ny[e] * ay)
-            if den == 0.0:
-                if num <= 0.0:
-                    lo = 2.0
-                    break
-            elif den > 0.0:
-                hi = min(hi, num / den)
-            else:
-                lo = max(lo, num / den)
-            if lo >= hi:
-                break
-        if lo < hi:
-            return True
-    return False
-
-
-@njit(cache=True, inline="always")
-def _tangent(ux: float, uy: float, px: float, py: float, qx: float, qy: float, vx: float,
-             vy: float) -> bool:
-    """True unless the line u->v separates u's boundary neighbours p and q (bitangent test)."""
-    dx = vx - ux
-    dy = vy - uy
-    s1 = dx * (py - uy) - dy * (px - ux)
-    s2 = dx * (qy - uy) - dy * (qx - ux)
-    tol = 1e-12 * (abs(dx) + abs(dy) + 1.0)
-    return not ((s1 > tol and s2 < -tol) or (s1 < -tol and s2 > tol))
-
-
-@njit(cache=True, inline="always")
-def _bitangent(i: int, j: int, px: np.ndarray, py: np.ndarray, prv: np.ndarray, nxt: np.ndarray,
-               n_free: int) -> bool:
-    """The tangent test of edge ij at both ends; nodes ``[0, n_free)`` (start, goal) skip it."""
-    if i >= n_free and not _tangent(px[i], py[i], prv[i, 0], prv[i, 1], nxt[i, 0], nxt[i, 1],
-                                    px[j], py[j]):
-        return False
-    return not (j >= n_free and not _tangent(px[j], py[j], prv[j, 0], prv[j, 1], nxt[j, 0],
-                                             nxt[j, 1], px[i], py[i]))
-
-
-@njit(cache=True, inline="always")
-def _append(ei: np.ndarray, ej: np.ndarray, m: int, i: int,
-            j: int) -> tuple[np.ndarray, np.ndarray]:
-    """Edge ij as the m-th, in arrays that double when full."""
-    if m == ei.shape[0]:
-        ei2 = np.empty(2 * m, np.int64)
-        ej2 = np.empty(2 * m, np.int64)
-        for q in range(m):  # not a slice copy: that compiles numba's error formatting
-            ei2[q] = ei[q]
-            ej2[q] = ej[q]
-        ei = ei2
-        ej = ej2
-    ei[m] = i
-    ej[m] = j
-    return ei, ej
-
-
-@njit(cache=True, inline="always")
-def _weighted(px: np.ndarray, py: np.ndarray, ei: np.ndarray, ej: np.ndarray,
-              m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The m edges and their lengths."""
-    w = np.empty(m)
-    for e in range(m):
-        w[e] = math.hypot(px[ei[e]] - px[ej[e]], py[ei[e]] - py[ej[e]])
-    return ei[:m], ej[:m], w
-
-
-@njit(cache=True)
-def _edges(px: np.ndarray, py: np.ndarray, prv: np.ndarray, nxt: np.ndarray, n_free: int,
-           exact: bool, radius: float, comps: Components, obs: ObstacleArrays,
-           box_limit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Visible bitangent edges; nodes ``[0, n_free)`` (start, goal) skip the tangent test.
-
-    ``exact``: the exact test at ``radius`` against the obstacle record ``obs``; else the
-    interior test of the components and, if ``box_limit`` > 0, the exact test at
-    ``box_limit`` against ``obs`` (then a map's boxes alone)."""
-    n = px.shape[0]
-    ei = np.empty(1024, np.int64)
-    ej = np.empty(1024, np.int64)
-    m = 0
-    limit = radius - 1e-9
-    for i in range(n):
-        for j in range(i + 1, n):
-            if not _bitangent(i, j, px, py, prv, nxt, n_free):
-                continue
-            if exact:
-                if segment_blocked_kernel(px[i], py[i], px[j], py[j], obs, limit):
-                    continue
-            else:
-                if _segment_hits_any(px[i], py[i], px[j], py[j], comps, 1e-9):
-                    continue
-                if box_limit > 0.0 and segment_blocked_kernel(px[i], py[i], px[j], py[j], obs,
-                                                              box_limit):
-                    continue
-            ei, ej = _append(ei, ej, m, i, j)
-            m += 1
-    return _weighted(px, py, ei, ej, m)
-
-
-@njit(cache=True)
-def _edges_relaxed(px: np.ndarray, py: np.ndarray, prv: np.ndarray, nxt: np.ndarray,
-                   n_free: int, comps: Components) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`_edges` with the interior test alone (``exact`` False, ``box_limit`` 0: the lower
-    variant without a map), the same edges: it links none of the clearance kernels, so it
-    compiles in a third of the time (the feasibility check of every run without a map)."""
-    n = px.shape[0]
-    ei = np.empty(1024, np.int64)
-    ej = np.empty(1024, np.int64)
-    m = 0
-    for i in range(n):
-        for j in range(i + 1, n):
-            if not _bitangent(i, j, px, py, prv, nxt, n_free):
-                continue
-            if _segment_hits_any(px[i], py[i], px[j], py[j], comps, 1e-9):
-                continue
-            ei, ej = _append(ei, ej, m, i, j)
-            m += 1
-    return _weighted(px, py, ei, ej, m)
 
 
 # ------------------------------------------------------------------------------------------
@@ -487,7 +291,7 @@ def shortest_path(problem: Problem, *, variant: str = "feasible",
             if box_limit > 0.0:
                 keep &= _box_set(problem).clearances(nodes) >= box_limit
             idx = np.flatnonzero(keep)
-            keep[idx[_points_in_any(np.ascontiguousarray(nodes[idx, 0]),
+            keep[idx[points_in_any(np.ascontiguousarray(nodes[idx, 0]),
                                     np.ascontiguousarray(nodes[idx, 1]), comps, _EPS)]] = False
         nodes, prv, nxt = nodes[keep], prv[keep], nxt[keep]
     else:
@@ -501,14 +305,14 @@ def shortest_path(problem: Problem, *, variant: str = "feasible",
     oarr = problem.obstacles.arrays if exact or box_limit <= 0.0 else _box_set(problem).arrays
     px, py = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
     if exact or box_limit > 0.0:
-        ei, ej, w = _edges(px, py, prv, nxt, 2, exact, problem.check_radius, comps, oarr, box_limit)
+        ei, ej, w = edges(px, py, prv, nxt, 2, exact, problem.check_radius, comps, oarr, box_limit)
     else:
-        ei, ej, w = _edges_relaxed(px, py, prv, nxt, 2, comps)
+        ei, ej, w = edges_relaxed(px, py, prv, nxt, 2, comps)
     from scipy.sparse import coo_matrix  # lazy: keeps `import anyplan.planning` light
     from scipy.sparse.csgraph import dijkstra
 
     n = len(pts)
-    # The "lower" variant needs no wall test in _edges: both ends lie in the shrunk box, which
+    # The "lower" variant needs no wall test in edges: both ends lie in the shrunk box, which
     # is convex, so the whole segment does too.
     g = coo_matrix((np.concatenate([w, w]), (np.concatenate([ei, ej]), np.concatenate([ej, ei]))),
                    shape=(n, n)).tocsr()
@@ -528,6 +332,18 @@ def lower_bound(problem: Problem, arc_step: float = DEFAULT_ARC_STEP) -> float:
     if res.status in (PlannerStatus.INVALID_START, PlannerStatus.INVALID_GOAL):
         return math.inf
     return res.cost
+
+
+def warm_up() -> None:
+    """Compile (or load) the kernels of the lower variant without a map (the feasibility check
+    before every run, the time lower bound) on a made-up square, without a clearance query: a
+    second process can compile them on a cold cache while the first compiles the clearance
+    kernels (:mod:`anyplan.agents.warmup`)."""
+    comps = _pack([np.array([[1.0, 1.0], [2.0, 1.0], [2.0, 2.0], [1.0, 2.0]])])
+    px, py = np.array([0.0, 3.0, 0.9, 2.1]), np.array([0.0, 3.0, 2.1, 0.9])
+    points_in_any(px, py, comps, _EPS)
+    tangents = np.ascontiguousarray(np.column_stack([px, py]))
+    edges_relaxed(px, py, tangents, tangents, 2, comps)
 
 
 class VisGraphPlanner(Planner):
