@@ -266,6 +266,13 @@ class ObstacleSet:
         limit = float(limit)
         return self._queries(k.PASS_FAIL, points, None, limit) >= limit
 
+    def segments_clear(self, a: np.ndarray, b: np.ndarray, limit: float) -> np.ndarray:
+        """Boolean mask (N,): the clearance of each segment ``a[i] -> b[i]`` is >= ``limit``
+        [m] (pass/fail only, as ``segment_blocked_kernel``: on a map it scans only the cells
+        within ``limit`` of each segment)."""
+        limit = float(limit)
+        return self._queries(k.PASS_FAIL, a, b, limit) >= limit
+
     def segments_clearance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Exact clearance of each segment ``a[i] -> b[i]``, both shape (N, 2); result (N,)."""
         return self._queries(k.SEGMENT, a, b, -1.0)

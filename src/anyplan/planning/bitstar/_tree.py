@@ -14,8 +14,6 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from anyplan.geometry.collision import ObstacleArrays, segment_blocked_kernel
-
 
 class Tree(NamedTuple):
     """The search tree over C point slots. Produced by :func:`new_tree` and
@@ -171,18 +169,3 @@ def surviving_vertices(t: Tree, n: int, state: np.ndarray) -> np.ndarray:
             top += 1
             c = t.next_sibling[c]
     return keepv
-
-
-@njit(cache=True)
-def blocked_edges(xy: np.ndarray, t: Tree, n: int, obs: ObstacleArrays,
-                  limit: float) -> np.ndarray:
-    """Mask (n,) of the vertices whose tree edge (parent -> vertex) is blocked by ``obs``
-    (clearance below ``limit`` [m])."""
-    out = np.zeros(n, np.bool_)
-    for i in range(n):
-        p = t.parent[i]
-        if p < 0:
-            continue
-        if segment_blocked_kernel(xy[p, 0], xy[p, 1], xy[i, 0], xy[i, 1], obs, limit):
-            out[i] = True
-    return out

@@ -51,7 +51,7 @@ def warm_up() -> float:
     obs = ObstacleSet([Circle((2.0, 2.0), 0.5)], bounds=(0.0, 0.0, 4.0, 4.0))
     p = BITStar(Problem.create(obs, (0.5, 0.5), (3.5, 3.5), 0.1), rng=0, samples_per_batch=30)
     p.solve(batches(2))  # iterate, start_batch, build_grid, compact (prune), sampling
-    p.add_obstacles([Circle((3.0, 1.0), 0.2)])  # blocked_edges (Sequential BIT* uses it)
+    p.add_obstacles([Circle((3.0, 1.0), 0.2)])  # Sequential BIT* uses it
     dt = time.perf_counter() - t0
     logger.debug("BIT* kernels ready in %.3f s", dt)
     return dt
@@ -339,7 +339,10 @@ class BITStar(Planner):
         state = np.where(t.vertex[:n], 2, 1).astype(np.int64)
         free = new_only.clearances(p.xy[:n]) >= self._limit
         state[~free] = 0
-        blocked = _tree.blocked_edges(p.xy, t, n, new_only.arrays, self._limit)
+        # tree edges (parent -> vertex) that the new obstacles block
+        child = np.flatnonzero(t.parent[:n] >= 0)
+        blocked = np.zeros(n, np.bool_)
+        blocked[child] = ~new_only.segments_clear(p.xy[t.parent[child]], p.xy[child], self._limit)
         state[blocked & free] = 1
         _graph.compact(p, t, state, self.n_batches + 1)
         old_cost = self.best_cost
