@@ -180,17 +180,14 @@ def test_second_process_fills_the_cache_that_this_process_then_loads(no_parts_lo
     assert out.stdout.strip() == "0"  # everything loaded from the cache the second process wrote
 
 
-def test_stmap_part_loads_no_kernel_of_the_motion_part():
-    """The s-t map part runs while a second process compiles the motion part (the parts' order
-    in PARTS puts it first): it must not need that part's kernels, or it would compile them again
-    on this side."""
+def _kernel_modules_after(code: str) -> list[str]:
+    """The modules of anyplan's compiled kernels that hold code (compiled or loaded) after
+    ``code`` runs in a fresh process."""
     import subprocess
     import sys
 
     probe = (
-        "import sys, importlib\n"
-        "from anyplan.agents.warmup import warm_up_kernels\n"
-        "warm_up_kernels(['stmap'])\n"
+        "import sys\n" + code +
         "from numba.core.registry import CPUDispatcher\n"
         "used = set()\n"
         "for name, mod in list(sys.modules.items()):\n"
@@ -201,7 +198,15 @@ def test_stmap_part_loads_no_kernel_of_the_motion_part():
         "print(' '.join(sorted(used)))\n")
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                          timeout=600, check=True)
-    used = out.stdout.split()
+    return out.stdout.split()
+
+
+def test_stmap_part_loads_no_kernel_of_the_motion_part():
+    """The s-t map part runs while a second process compiles the motion part (the parts' order
+    in PARTS puts it first): it must not need that part's kernels, or it would compile them again
+    on this side."""
+    used = _kernel_modules_after("from anyplan.agents.warmup import warm_up_kernels\n"
+                                 "warm_up_kernels(['stmap'])\n")
     assert "anyplan.trajectory.spacetime.stmap" in used  # the probe sees what ran
     assert "anyplan.trajectory.spacetime._lattice_kernels" in used
     motion = [m for m in used if m.startswith(("anyplan.trajectory.spline", "anyplan.trajectory.profile",
@@ -215,26 +220,10 @@ def test_motion_part_compiles_its_curve_kernels_before_any_clearance_kernel():
     """A second process compiling the motion part on a cold cache starts with the kernels that
     query no obstacle (``_curves``), so that it meets the clearance kernels only once this
     process, which compiles them first (scenario loading, BIT*), has put them in the cache."""
-    import subprocess
-    import sys
-
-    probe = (
-        "import sys\n"
-        "import numpy as np\n"
-        "import anyplan.agents.warmup as wu\n"
-        "obs, spec = wu._scene()\n"
-        "wu._curves(spec, np.array([[0.5, 0.5], [3.0, 1.2], [3.5, 3.5]]))\n"
-        "from numba.core.registry import CPUDispatcher\n"
-        "used = set()\n"
-        "for name, mod in list(sys.modules.items()):\n"
-        "    if name.startswith('anyplan.'):\n"
-        "        for attr in vars(mod).values():\n"
-        "            if isinstance(attr, CPUDispatcher) and attr.signatures:\n"
-        "                used.add(attr.py_func.__module__)\n"
-        "print(' '.join(sorted(used)))\n")
-    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
-                         timeout=600, check=True)
-    used = out.stdout.split()
+    used = _kernel_modules_after("import numpy as np\n"
+                                 "import anyplan.agents.warmup as wu\n"
+                                 "obs, spec = wu._scene()\n"
+                                 "wu._curves(spec, np.array([[0.5, 0.5], [3.0, 1.2], [3.5, 3.5]]))\n")
     assert {"anyplan.trajectory.spline._fit", "anyplan.trajectory.profile",
             "anyplan.trajectory.spline._drive"} <= set(used)
     assert not [m for m in used if m.startswith("anyplan.geometry")]
