@@ -54,13 +54,17 @@ def test_certified_first_contact_circular_never_late(x0, y0, th, v, om, px, py, 
     t = np.linspace(0.0, 20.0, 200001)
     d = np.hypot(*(robot(t) - m.positions(t)).T)
     hit = np.nonzero(d <= R)[0]
+    dc = (None if tc is None else
+          float(np.hypot(*(robot(np.array([tc])) - m.positions(np.array([tc])))[0])))
     if len(hit):
-        assert tc is not None and tc <= t[hit[0]] + 1e-9
+        assert tc is not None and dc is not None and tc <= t[hit[0]] + 1e-9
         # Never earlier than the true contact (within one 1e-4 s grid step of the first sampled
-        # hit) by more than the search tolerance (1e-6 s).
-        assert tc >= t[hit[0]] - 1e-4 - 1e-6 - 1e-9
-    if tc is not None:
-        dc = np.hypot(*(robot(np.array([tc])) - m.positions(np.array([tc])))[0])
+        # hit) by more than the search tolerance (1e-6 s), unless the distance there is already
+        # within L x tol of the contact distance: a graze the search cannot tell from a contact,
+        # reported as one (conservative, as documented; a tangent contact at t = 2 s is reported
+        # 0.5 ms early, where the distance is 4e-8 m above R).
+        assert tc >= t[hit[0]] - 1e-4 - 1e-6 - 1e-9 or dc <= R + L * 1e-6 + 1e-9
+    if tc is not None and dc is not None:
         if dc > R + L * 1e-6 + 1e-9:
             # A conservative early answer: only when the distance grazes the contact distance
             # for long (the evaluation budget of a near-plateau ran out).
