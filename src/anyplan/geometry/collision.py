@@ -240,7 +240,8 @@ class ObstacleSet:
 
     # --- batched queries ------------------------------------------------------------------
     def _queries(self, kind: int, a: np.ndarray, b: np.ndarray | None, arg: float) -> np.ndarray:
-        """:meth:`_query` of each (a[n], b[n]) (b None: a), ``a``, ``b`` shape (N, 2)."""
+        """The query ``kind`` (``py_query``'s) of each (a[n], b[n]) (b None: a), ``a``, ``b``
+        shape (N, 2)."""
         o = self._arrays
         a = np.asarray(a, dtype=float).reshape(-1, 2)
         ax, ay = np.ascontiguousarray(a[:, 0]), np.ascontiguousarray(a[:, 1])
@@ -279,8 +280,7 @@ class ObstacleSet:
 
     def segments_free(self, a: np.ndarray, b: np.ndarray, radius: float) -> np.ndarray:
         """Boolean mask (N,): a disc of ``radius`` moving along each segment touches nothing."""
-        limit = radius - COLLISION_EPS
-        return self._queries(k.SEGMENT, a, b, limit) >= limit
+        return self.segments_clear(a, b, radius - COLLISION_EPS)
 
     def path_free(self, path: np.ndarray, radius: float) -> bool:
         """True if every segment of the polyline ``path`` (N, 2) is free for the disc robot."""
