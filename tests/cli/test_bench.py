@@ -50,13 +50,20 @@ def test_bench_then_report(tmp_path, tiny, capsys, other):
     assert "4/4" in cap.err and "ETA" in cap.err  # the progress bar, on stderr
     assert "path length [m]" in cap.out and other in cap.out
     # One row per number of moving obstacles, 2 successes of 2 runs; time over the lower bound
-    # >= 1; no collision, none robot-caused, no timeout, no error.
-    # then the minimum distance to the moving obstacles and the discomfort time.
-    assert re.search(r"^\s+1\s+4\.8\d\d ± 0\.000.*\s1\.\d\d\d ± \d\.\d\d\d\s+2/2\s+0\s+0\s+0\s+0"
+    # >= 1; the success rate's Wilson interval (0.34-1.00 for 2 of 2); no collision, none
+    # robot-caused, no timeout, no error; then the minimum distance to the moving obstacles and
+    # the discomfort time.
+    assert re.search(r"^\s+1\s+4\.8\d\d ± 0\.000.*\s1\.\d\d\d ± \d\.\d\d\d\s+2/2\s+0\.34-1\.00"
+                     r"\s+0\s+0\s+0\s+0"
                      r"\s+-?\d+\.\d{3}\s+\d\.\d\d( ± \d\.\d\d)?$",
                      cap.out, re.M), cap.out
+    # the two planners ran the same scenario and seeds: one paired comparison, both reached
+    # every run (no difference: 0 with an interval around it, McNemar's p = 1)
+    pair = f"(straight\\s+{re.escape(other)}|{re.escape(other)}\\s+straight)"
+    assert re.search(r"^" + pair + r"\s+2\s+2 / 2\s+\+0\.0 % \[-\d+\.\d, "
+                     r"\+\d+\.\d\] \(p = 1\)", cap.out, re.M), cap.out
     md = (out / "tables.md").read_text()
-    assert "| moving obstacles | path length [m]" in md
+    assert "| moving obstacles | path length [m]" in md and "### Paired comparisons" in md
     rows = list(csv.DictReader((out / "tables.csv").read_text().splitlines()))
     assert {r["planner"] for r in rows} == {"straight", other}
     assert all(r["runs"] == "2" and r["successes"] == "2" for r in rows)
@@ -76,7 +83,7 @@ def test_bench_then_report(tmp_path, tiny, capsys, other):
     imgs = re.findall(r"src='data:image/png;base64,([^']+)'", page)
     assert len(imgs) == 2 + has_progress
     assert all(base64.b64decode(b)[:8] == b"\x89PNG\r\n\x1a\n" for b in imgs)
-    assert other in page and "<table class='sortable'>" in page
+    assert other in page and "<table class='sortable'>" in page and "Paired comparisons" in page
 
 
 def test_bench_resume_flag_and_refusal(tmp_path, tiny, capsys):

@@ -138,6 +138,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from anyplan.experiments.runner import BenchInterrupted, parse_planners, run_bench
     from anyplan.experiments.suites import resolve_suite
     from anyplan.experiments.tables import (
+        compare_planners,
+        format_comparisons,
         format_paper_comparison,
         format_text,
         paper_runs,
@@ -202,6 +204,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
     print(f"{summary.finished} runs now, {summary.skipped} already stored; "
           f"{len(runs)} runs in {db_path} for this bench ({summary.wall_time_s:.1f} s)\n")
     print(format_text(tables))
+    pairs = compare_planners(runs)
+    if pairs:
+        print("\npaired comparisons (the runs both configurations made):\n" + format_comparisons(pairs))
     ptables = summarize(paper_runs(runs))
     cmp = format_paper_comparison(ptables)
     if cmp:
@@ -213,7 +218,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         print("\n" + barn[0])
     if args.out:
         try:
-            paths = write_tables(tables, args.out, ptables)
+            paths = write_tables(tables, args.out, ptables, pairs)
             if barn:
                 paths.append(Path(args.out) / "barn.md")
                 paths[-1].write_text(barn[1])

@@ -3,8 +3,10 @@
 One table per planner configuration, one row per number of moving obstacles, with the paper's
 columns (path length, path generation time, time to goal; mean ± sample std) plus the outcome
 counts (successes, collisions, robot-caused collisions, timeouts, errors) and the time over the
-run's lower bound. The paper's own numbers (Roy, Harchowdhury & Vachhani, Tables 2-3) are in
-:data:`PAPER_TABLES`.
+run's lower bound, with the success rate's 95 % Wilson interval. Planner configurations run on
+the same scenarios and seeds are compared pair by pair (:func:`compare_planners`: the difference
+in success and in robot-caused collisions, Newcombe's interval, McNemar's exact p). The paper's
+own numbers (Roy, Harchowdhury & Vachhani, Tables 2-3) are in :data:`PAPER_TABLES`.
 
 What each column averages over: ``docs/experiments.md``, "The paper's tables: columns".
 """
@@ -21,9 +23,12 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["PAPER_TABLES", "PAPER_SCENARIOS", "Stat", "TableRow", "PlannerTable", "summarize",
-           "paper_runs", "format_text", "format_markdown", "format_csv", "format_paper_comparison",
-           "write_tables"]
+from anyplan.experiments.significance import PairedComparison, compare_outcomes, wilson_interval
+
+__all__ = ["PAPER_TABLES", "PAPER_SCENARIOS", "Stat", "TableRow", "PlannerTable", "PlannerPair",
+           "COMPARISON_HEADERS", "summarize", "compare_planners", "pair_cells", "paper_runs",
+           "format_text", "format_markdown", "format_csv", "format_comparisons",
+           "format_paper_comparison", "write_tables"]
 
 #: The paper's figures per planner registry name and number of moving obstacles:
 #: (path length [m], path generation time [s], time to goal [s]), or None for "crashed".
@@ -143,15 +148,89 @@ def summarize(runs: Sequence[Mapping[str, Any]]) -> list[PlannerTable]:
     return tables
 
 
+def _run_key(r: Mapping[str, Any]) -> tuple[Any, ...]:
+    """What makes two planners' runs a pair: the same scenario (content), run index and seed."""
+    return (r.get("scenario_hash") or r.get("scenario"), r.get("run_index"), r.get("seed"))
+
+
+@dataclass(frozen=True)
+class PlannerPair:
+    """Two planner configurations over the runs they share (same scenario, run index, seed).
+
+    Attributes:
+        a, b: The configurations' titles (:attr:`PlannerTable.title`).
+        reached: Paired comparison of reaching the goal (A's rate - B's).
+        robot_caused: Paired comparison of ending in a robot-caused collision.
+    """
+
+    a: str
+    b: str
+    reached: PairedComparison
+    robot_caused: PairedComparison
+
+
+def compare_planners(runs: Sequence[Mapping[str, Any]], level: float = 0.95) -> list[PlannerPair]:
+    """Every pair of planner configurations in ``runs`` (rows as for :func:`summarize`) that
+    share at least one run, in the order of :func:`summarize`'s tables. Errors count as not
+    reached; a run key stored twice for one configuration keeps its last row."""
+    by_config: dict[str, dict[tuple[Any, ...], Mapping[str, Any]]] = {}
+    for t in summarize(runs):
+        by_config[t.title] = {}
+    for r in runs:
+        if r.get("outcome") is None or r.get("n_moving") is None:
+            continue
+        title = PlannerTable(str(r["planner"]), str(r.get("settings") or "")).title
+        by_config[title][_run_key(r)] = r
+    titles = list(by_config)
+    pairs = []
+    for i, ta in enumerate(titles):
+        for tb in titles[i + 1:]:
+            ra, rb = by_config[ta], by_config[tb]
+            if not any(k in rb for k in ra):
+                continue
+
+            def outcome(rs: Mapping[Any, Mapping[str, Any]], caused: bool) -> dict[Any, bool]:
+                if not caused:
+                    return {k: r["outcome"] == "reached" for k, r in rs.items()}
+                return {k: r["outcome"] == "collision" and bool(r.get("robot_caused"))
+                        for k, r in rs.items()}
+
+            pairs.append(PlannerPair(ta, tb, compare_outcomes(outcome(ra, False), outcome(rb, False), level),
+                                     compare_outcomes(outcome(ra, True), outcome(rb, True), level)))
+    return pairs
+
+
+COMPARISON_HEADERS = ["A", "B", "paired runs", "reached A / B", "A - B reached [95 % CI] (McNemar p)",
+                      "robot-caused A / B", "A - B robot-caused [95 % CI] (McNemar p)"]
+
+
+def pair_cells(p: PlannerPair) -> list[str]:
+    """The cells of one pair's row, under :data:`COMPARISON_HEADERS`."""
+    r, c = p.reached, p.robot_caused
+    return [p.a, p.b, str(r.n), f"{r.both + r.only_a} / {r.both + r.only_b}", r.fmt(),
+            f"{c.both + c.only_a} / {c.both + c.only_b}", c.fmt()]
+
+
+def format_comparisons(pairs: Sequence[PlannerPair], markdown: bool = False) -> str:
+    """The paired comparisons as a table (empty without pairs). An interval that excludes 0 is
+    a difference the runs show at its level; one that holds 0 does not show one."""
+    if not pairs:
+        return ""
+    rows = [pair_cells(p) for p in pairs]
+    return _md(COMPARISON_HEADERS, rows) if markdown else _grid(COMPARISON_HEADERS, rows)
+
+
 HEADERS = ["moving obstacles", "path length [m]", "path generation time [s]", "time to goal [s]",
-           "time / lower bound", "successes", "collisions", "robot-caused collisions", "timeouts",
-           "errors", "min distance to moving [m]", "discomfort time [s]"]
+           "time / lower bound", "successes", "success 95 % CI", "collisions",
+           "robot-caused collisions", "timeouts", "errors", "min distance to moving [m]",
+           "discomfort time [s]"]
 
 
 def _cells(row: TableRow) -> list[str]:
     return [str(row.n_moving), row.path_length.fmt(3), row.generation_time.fmt(4),
             row.time_to_goal.fmt(2), row.time_over_bound.fmt(3), f"{row.successes}/{row.runs}",
-            str(row.crashes), str(row.robot_caused), str(row.timeouts), str(row.errors),
+            "{:.2f}-{:.2f}".format(*wilson_interval(row.successes, row.runs)), str(row.crashes),
+            str(row.robot_caused), str(row.timeouts), str(row.errors),
             "-" if not math.isfinite(row.min_distance_to_moving) else f"{row.min_distance_to_moving:.3f}",
             row.discomfort_time.fmt(2)]
 
@@ -179,12 +258,16 @@ def _md(headers: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
 
 
 def format_markdown(tables: Sequence[PlannerTable],
-                    paper_tables: Sequence[PlannerTable] | None = None) -> str:
-    """Markdown tables (one per planner), then ``paper_tables`` (tables of the runs on the paper
+                    paper_tables: Sequence[PlannerTable] | None = None,
+                    pairs: Sequence[PlannerPair] = ()) -> str:
+    """Markdown tables (one per planner), the paired comparisons ``pairs``
+    (:func:`compare_planners`), then ``paper_tables`` (tables of the runs on the paper
     scenarios, see :func:`paper_runs`) beside the paper's figures."""
     parts = []
     for t in tables:
         parts.append(f"### {t.title}\n\n" + _md(HEADERS, [_cells(r) for r in t.rows]))
+    if pairs:
+        parts.append("### Paired comparisons\n\n" + format_comparisons(pairs, markdown=True))
     cmp = format_paper_comparison(paper_tables or [], markdown=True)
     if cmp:
         parts.append("### Ours against the paper\n\n" + cmp)
@@ -199,7 +282,8 @@ def format_csv(tables: Sequence[PlannerTable]) -> str:
                 "errors", "path_length_mean_m", "path_length_std_m", "generation_time_mean_s",
                 "generation_time_std_s", "time_to_goal_mean_s", "time_to_goal_std_s",
                 "robot_caused_collisions", "time_over_lower_bound_mean", "time_over_lower_bound_std",
-                "min_distance_to_moving_m", "discomfort_time_mean_s"])
+                "min_distance_to_moving_m", "discomfort_time_mean_s", "success_ci95_low",
+                "success_ci95_high", "robot_caused_ci95_low", "robot_caused_ci95_high"])
 
     def num(x: float) -> str:
         return "" if not math.isfinite(x) else f"{x:.6g}"
@@ -211,7 +295,9 @@ def format_csv(tables: Sequence[PlannerTable]) -> str:
                         num(r.generation_time.mean), num(r.generation_time.std),
                         num(r.time_to_goal.mean), num(r.time_to_goal.std), r.robot_caused,
                         num(r.time_over_bound.mean), num(r.time_over_bound.std),
-                        num(r.min_distance_to_moving), num(r.discomfort_time.mean)])
+                        num(r.min_distance_to_moving), num(r.discomfort_time.mean),
+                        *map(num, wilson_interval(r.successes, r.runs)),
+                        *map(num, wilson_interval(r.robot_caused, r.runs))])
     return buf.getvalue()
 
 
@@ -246,11 +332,13 @@ def format_paper_comparison(tables: Sequence[PlannerTable], markdown: bool = Fal
 
 
 def write_tables(tables: Sequence[PlannerTable], out: str | Path,
-                 paper_tables: Sequence[PlannerTable] | None = None) -> list[Path]:
-    """Write ``tables.md`` and ``tables.csv`` into folder ``out``; returns the paths."""
+                 paper_tables: Sequence[PlannerTable] | None = None,
+                 pairs: Sequence[PlannerPair] = ()) -> list[Path]:
+    """Write ``tables.md`` (with the paired comparisons ``pairs``) and ``tables.csv`` into
+    folder ``out``; returns the paths."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     md, cs = out / "tables.md", out / "tables.csv"
-    md.write_text("# Benchmark tables\n\n" + format_markdown(tables, paper_tables))
+    md.write_text("# Benchmark tables\n\n" + format_markdown(tables, paper_tables, pairs))
     cs.write_text(format_csv(tables))
     return [md, cs]

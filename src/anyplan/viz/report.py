@@ -24,7 +24,7 @@ from matplotlib.colors import Normalize
 from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter
 
 from anyplan.experiments.db import ResultsDB
-from anyplan.experiments.tables import paper_runs, summarize, write_tables
+from anyplan.experiments.tables import compare_planners, paper_runs, summarize, write_tables
 from anyplan.viz.run import PATH_CMAP, draw_run, run_legend_handles
 from anyplan.viz.style import (
     COLUMN_WIDTH_IN,
@@ -338,7 +338,8 @@ def build_report(db_path: str | Path, out: str | Path, fmt: str = "png") -> list
         runs = db.runs()
         tables = summarize(runs)
         ptables = summarize(paper_runs(runs))
-        written = write_tables(tables, out, ptables)
+        pairs = compare_planners(runs)
+        written = write_tables(tables, out, ptables, pairs)
         pngs: list[tuple[str, bytes]] = []
         for title, fn, name in (("Figure 4: executed paths", figure4, "figure4"),
                                 ("Metrics", boxplots, "boxplots"),
@@ -349,5 +350,5 @@ def build_report(db_path: str | Path, out: str | Path, fmt: str = "png") -> list
                 written.append(p)
                 pngs.append((title, buf.getvalue()))
         data = report_data(db, _scenarios(db), db_name=Path(db_path).name)
-    written.append(render_page(data, ptables, pngs, out / "report.html"))
+    written.append(render_page(data, ptables, pngs, out / "report.html", pairs))
     return written

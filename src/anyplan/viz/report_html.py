@@ -21,7 +21,13 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from anyplan.experiments.tables import PAPER_TABLES, PlannerTable
+from anyplan.experiments.tables import (
+    COMPARISON_HEADERS,
+    PAPER_TABLES,
+    PlannerPair,
+    PlannerTable,
+    pair_cells,
+)
 
 __all__ = ["render_page"]
 
@@ -174,10 +180,22 @@ def _finite(obj: Any) -> Any:
     return obj
 
 
+def _pairs(pairs: Sequence[PlannerPair]) -> str:
+    if not pairs:
+        return ""
+    rows = [[_td(c) for c in pair_cells(p)] for p in pairs]
+    return ("<h3>Paired comparisons</h3><p class='note'>Two configurations over the runs both "
+            "made (same scenario, run index and seed): the difference of their rates with its "
+            "95 % interval (Newcombe) and McNemar's exact p. An interval that holds 0 does not "
+            "show a difference at that level.</p>" + _table(COMPARISON_HEADERS, rows))
+
+
 def render_page(data: Mapping[str, Any], ptables: Sequence[PlannerTable],
-                figures: Sequence[tuple[str, bytes]], out: Path) -> Path:
-    """Write ``out`` (the HTML file) from the report data, the paper comparison tables and the
-    figures as PNG bytes ``(title, png)``; returns ``out``."""
+                figures: Sequence[tuple[str, bytes]], out: Path,
+                pairs: Sequence[PlannerPair] = ()) -> Path:
+    """Write ``out`` (the HTML file) from the report data, the paper comparison tables, the
+    figures as PNG bytes ``(title, png)`` and the paired comparisons ``pairs``
+    (:func:`anyplan.experiments.tables.compare_planners`); returns ``out``."""
     toc = "".join(f"<li><a href='#{sid}'>{_e(title)}</a></li>" for sid, title in SECTIONS)
     figs = "".join(f"<h3>{_e(t)}</h3><img alt='{_e(t)}' src='data:image/png;base64,"
                    f"{base64.b64encode(png).decode()}'>" for t, png in figures) or "<p>No figures.</p>"
@@ -185,7 +203,8 @@ def render_page(data: Mapping[str, Any], ptables: Sequence[PlannerTable],
         "overview": _meta(data),
         "tables": ("<p class='note'>One table per planner configuration, one row per number of "
                    "moving obstacles. Path length and time to goal are over the successful runs; "
-                   "crashes are collisions; errors are planner exceptions.</p>" + _summary_tables(data)),
+                   "crashes are collisions; errors are planner exceptions.</p>" + _summary_tables(data)
+                   + _pairs(pairs)),
         "paper": _paper_tables(ptables),
         "plots": "<div class='plots' id='plots-box'></div>",
         "runs": "<p id='runs-filter'></p>" + _runs_table(data),
