@@ -17,8 +17,10 @@ docs/perception.md), for every planner and peer on the same seeds:
 Per (suite, mode, planner): successes, collisions, robot-caused collisions, smallest distance to
 a moving obstacle, discomfort time, time / lower bound, planning time per call (median and 95th
 percentile over all calls; a call's whole wall-clock time, safety guard and fallbacks included,
-since 2026-12-03 for ``st-bitstar``). Targets (issue 15) are printed beside the figures. With
-``--jobs 2`` on a 2-core machine the runs share it: read timings from ``--jobs 1``.
+since 2026-12-03 for ``st-bitstar``); the success rate with its 95 % Wilson interval
+(``benchmarks/compare_rows.py`` compares two ``--rows`` files run by run). Targets (issue 15)
+are printed beside the figures. With ``--jobs 2`` on a 2-core machine the runs share it: read
+timings from ``--jobs 1``.
 
 Usage::
 
@@ -184,8 +186,10 @@ def _prediction_dynabarn(worlds: list[int], tracker: tuple[tuple[str, float], ..
 
 
 def _table(rows: list[dict[str, Any]]) -> str:
-    head = ("| suite | mode | planner | success | collisions | robot-caused | min distance to moving "
-            "[m] | discomfort [s] | time / LB (median) | planning median / p95 [ms] | errors |")
+    from anyplan.experiments.significance import wilson_interval
+
+    head = ("| suite | mode | planner | success (95 % CI) | collisions | robot-caused | min distance to "
+            "moving [m] | discomfort [s] | time / LB (median) | planning median / p95 [ms] | errors |")
     out = [head, "|" + "---|" * 11]
     keys = sorted({(r["suite"], r["mode"], r["planner"]) for r in rows})
     for k in keys:
@@ -199,9 +203,10 @@ def _table(rows: list[dict[str, Any]]) -> str:
         lb = [r["t_over_lb"] for r in rs if r.get("t_over_lb") is not None and r["status"] == "reached"]
         pt = np.concatenate([np.asarray(r["times"], float) for r in rs]) * 1e3 if rs else np.zeros(0)
         err = sum(r["status"].startswith("error") for r in rs)
-        out.append(f"| {k[0]} | {k[1]} | {k[2]} | {ok}/{n} | {col} | {rc} | "
+        succ = "{}/{} ({:.2f}-{:.2f})".format(ok, n, *wilson_interval(ok, n))
+        out.append(f"| {k[0]} | {k[1]} | {k[2]} | {succ} | {col} | {rc} | "
                    f"{min(md):.3f} | {np.mean(disc):.2f} | " if md else
-                   f"| {k[0]} | {k[1]} | {k[2]} | {ok}/{n} | {col} | {rc} | - | - | ")
+                   f"| {k[0]} | {k[1]} | {k[2]} | {succ} | {col} | {rc} | - | - | ")
         out[-1] += (f"{np.median(lb):.2f} | " if lb else "- | ")
         out[-1] += (f"{np.median(pt):.1f} / {np.percentile(pt, 95):.1f} | " if pt.size else "- | ")
         out[-1] += f"{err} |"

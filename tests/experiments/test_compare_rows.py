@@ -1,0 +1,60 @@
+"""benchmarks/compare_rows.py: the paired comparison of two benchmark row files."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+
+import pytest
+
+PATH = Path(__file__).resolve().parents[2] / "benchmarks" / "compare_rows.py"
+
+
+@pytest.fixture(scope="module")
+def compare_rows():
+    spec = importlib.util.spec_from_file_location("compare_rows", PATH)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _rows(planner, outcomes, seed=0):
+    return [{"suite": "dynabarn", "mode": "tracked", "planner": planner, "scenario": f"w{i}",
+             "seed": seed, "status": s.rstrip("*"), "robot_caused": s.endswith("*")}
+            for i, s in enumerate(outcomes)]
+
+
+def test_pairs_two_files_and_lists_the_runs_that_differ(tmp_path, compare_rows, capsys):
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    a.write_text(json.dumps(_rows("st-bitstar", ["reached"] * 9 + ["collision*"])))
+    b.write_text(json.dumps(_rows("st-bitstar", ["collision"] * 8 + ["reached", "collision*"])
+                            + _rows("st-bitstar", ["reached"], seed=1)))
+    assert compare_rows.main([str(a), str(b), "--labels", "new,old", "--runs"]) == 0
+    out = capsys.readouterr().out
+    # 10 paired runs (the seed-1 run of b pairs with nothing): 9 against 1 reached, 8 one way
+    assert "| dynabarn tracked st-bitstar | 10 | reached | 9 | 1 | +80.0 % [" in out
+    assert "(p = 0.0078)" in out  # McNemar: 8 discordant pairs, all one way: 2 / 2**8
+    assert "| robot-caused | 1 | 1 | +0.0 % [" in out
+    assert "8 runs differ" in out and "w0 seed 0: new reached, old collision" in out
+
+
+def test_one_planner_per_file_pairs_across_names(tmp_path, compare_rows, capsys):
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    a.write_text(json.dumps(_rows("st-bitstar", ["reached", "reached"])))
+    b.write_text(json.dumps(_rows("seq-bitstar", ["reached", "timeout"])))
+    assert compare_rows.main([str(a), str(b)]) == 0
+    assert "st-bitstar / seq-bitstar | 2 | reached | 2 | 1 |" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("content", "message"), [
+    (None, "cannot read"), ("{", "not JSON"), ('{"a": 1}', "not a --rows file"),
+    (json.dumps(_rows("st-bitstar", ["reached"], seed=5)), "share no run")])
+def test_bad_files_are_one_line_and_exit_2(tmp_path, compare_rows, capsys, content, message):
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    if content is not None:
+        a.write_text(content)
+    b.write_text(json.dumps(_rows("st-bitstar", ["reached"])))
+    assert compare_rows.main([str(a), str(b)]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1 and str(a) in err
