@@ -7,11 +7,12 @@ reached, collided and collided robot-caused, the differences (A - B) with Newcom
 interval, and McNemar's exact p (``anyplan.experiments.significance``). An interval that holds 0
 does not show a difference; the closed loop of the DynaBARN runs is chaotic, so a total moving by
 a few runs says nothing until the interval says it does. ``--runs`` lists every run whose
-outcome differs.
+outcome differs. ``--modes MA,MB`` pairs file A's runs in perception mode MA with file B's in
+MB (e.g. ``tracked,twist``: what tracking costs against exact twists, world by world).
 
 Usage::
 
-    python benchmarks/compare_rows.py A.json B.json [--labels A,B] [--runs]
+    python benchmarks/compare_rows.py A.json B.json [--labels A,B] [--runs] [--modes MA,MB]
 """
 
 from __future__ import annotations
@@ -53,7 +54,11 @@ def _load(path: str) -> list[Row]:
     return rows
 
 
-def _groups(a: list[Row], b: list[Row]) -> list[tuple[str, dict[Any, Row], dict[Any, Row]]]:
+def _groups(a: list[Row], b: list[Row],
+            modes: tuple[str, str] | None = None) -> list[tuple[str, dict[Any, Row], dict[Any, Row]]]:
+    if modes is not None:  # one mode of each file, compared as if they were one
+        a = [dict(r, mode=f"{modes[0]} / {modes[1]}") for r in a if r["mode"] == modes[0]]
+        b = [dict(r, mode=f"{modes[0]} / {modes[1]}") for r in b if r["mode"] == modes[1]]
     pa, pb = sorted({r["planner"] for r in a}), sorted({r["planner"] for r in b})
     pairs = [(p, p) for p in pa if p in pb] or ([(pa[0], pb[0])] if len(pa) == len(pb) == 1 else [])
     out = []
@@ -81,10 +86,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("b")
     ap.add_argument("--labels", default="A,B", help="names of the two files in the output")
     ap.add_argument("--runs", action="store_true", help="list the runs whose outcomes differ")
+    ap.add_argument("--modes", default=None, metavar="MA,MB",
+                    help="pair A's runs in perception mode MA with B's in mode MB")
     args = ap.parse_args(argv)
     la, _, lb = args.labels.partition(",")
     try:
-        groups = _groups(_load(args.a), _load(args.b))
+        modes = None
+        if args.modes is not None:
+            ma, comma, mb = args.modes.partition(",")
+            if not (comma and ma and mb):
+                raise BadInput(f"--modes: two perception modes, MA,MB (got {args.modes!r})")
+            modes = (ma, mb)
+        groups = _groups(_load(args.a), _load(args.b), modes)
         if not groups:
             raise BadInput(f"{args.a} and {args.b} share no run (same suite, mode, planner, "
                            "scenario and seed)")

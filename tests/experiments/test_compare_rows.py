@@ -47,6 +47,18 @@ def test_one_planner_per_file_pairs_across_names(tmp_path, compare_rows, capsys)
     assert "st-bitstar / seq-bitstar | 2 | reached | 2 | 1 |" in capsys.readouterr().out
 
 
+def test_modes_pair_two_perception_modes(tmp_path, compare_rows, capsys):
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    a.write_text(json.dumps(_rows("st-bitstar", ["reached", "collision"])))
+    twist = [dict(r, mode="twist") for r in _rows("st-bitstar", ["reached", "reached"])]
+    b.write_text(json.dumps(twist + _rows("st-bitstar", ["timeout", "timeout"])))
+    assert compare_rows.main([str(a), str(b), "--modes", "tracked,twist"]) == 0
+    out = capsys.readouterr().out
+    assert "| dynabarn tracked / twist st-bitstar | 2 | reached | 1 | 2 | -50.0 % [" in out
+    assert compare_rows.main([str(a), str(b), "--modes", "tracked"]) == 2
+    assert "--modes" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize(("content", "message"), [
     (None, "cannot read"), ("{", "not JSON"), ('{"a": 1}', "not a --rows file"),
     (json.dumps(_rows("st-bitstar", ["reached"], seed=5)), "share no run")])
