@@ -36,6 +36,9 @@ OUTCOMES: dict[str, Callable[[Row], bool]] = {
     "reached": lambda r: r["status"] == "reached",
     "collided": lambda r: r["status"] == "collision",
     "robot-caused": lambda r: r["status"] == "collision" and bool(r.get("robot_caused")),
+    # ... with an obstacle there for longer than the robot's stopping time (unknown.py's column)
+    "robot-caused, seen in time": lambda r: (r["status"] == "collision" and bool(r.get("robot_caused"))
+                                             and r.get("appeared_within_stop") is not True),
 }
 
 

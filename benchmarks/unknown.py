@@ -14,7 +14,9 @@ docs/perception.md), for every planner and peer on the same seeds:
   against the constant-velocity baseline, and the coverage of the uncertainty radius; and the
   tracker's predictions of the DynaBARN worlds' obstacles (``--worlds``) 0.5-3 s ahead.
 
-Per (suite, mode, planner): successes, collisions, robot-caused collisions, smallest distance to
+Per (suite, mode, planner): successes, collisions, robot-caused collisions (and those of them
+with an obstacle there for longer than the robot's stopping time: "seen in time"; a replayed
+person whose recorded track begins on the robot is not), smallest distance to
 a moving obstacle, discomfort time, time / lower bound, planning time per call (median and 95th
 percentile over all calls; a call's whole wall-clock time, safety guard and fallbacks included,
 since 2026-12-03 for ``st-bitstar``); the success rate with its 95 % Wilson interval
@@ -185,12 +187,20 @@ def _prediction_dynabarn(worlds: list[int], tracker: tuple[tuple[str, float], ..
     return "\n".join(lines)
 
 
+def _seen_in_time(r: dict[str, Any]) -> bool:
+    """A robot-caused collision with an obstacle that had been there for longer than the robot
+    needs to stop (``appeared_within_stop`` false or unknown): one a planner could have avoided."""
+    return (r["status"] == "collision" and bool(r.get("robot_caused"))
+            and r.get("appeared_within_stop") is not True)
+
+
 def _table(rows: list[dict[str, Any]]) -> str:
     from anyplan.experiments.significance import wilson_interval
 
-    head = ("| suite | mode | planner | success (95 % CI) | collisions | robot-caused | min distance to "
-            "moving [m] | discomfort [s] | time / LB (median) | planning median / p95 [ms] | errors |")
-    out = [head, "|" + "---|" * 11]
+    head = ("| suite | mode | planner | success (95 % CI) | collisions | robot-caused | robot-caused, "
+            "seen in time | min distance to moving [m] | discomfort [s] | time / LB (median) | "
+            "planning median / p95 [ms] | errors |")
+    out = [head, "|" + "---|" * 12]
     keys = sorted({(r["suite"], r["mode"], r["planner"]) for r in rows})
     for k in keys:
         rs = [r for r in rows if (r["suite"], r["mode"], r["planner"]) == k]
@@ -198,15 +208,16 @@ def _table(rows: list[dict[str, Any]]) -> str:
         ok = sum(r["status"] == "reached" for r in rs)
         col = sum(r["status"] == "collision" for r in rs)
         rc = sum(r["status"] == "collision" and r.get("robot_caused") for r in rs)
+        rc_seen = sum(_seen_in_time(r) for r in rs)
         md = [r["min_dist"] for r in rs if r.get("min_dist") is not None]
         disc = [r["discomfort"] for r in rs if r.get("discomfort") is not None]
         lb = [r["t_over_lb"] for r in rs if r.get("t_over_lb") is not None and r["status"] == "reached"]
         pt = np.concatenate([np.asarray(r["times"], float) for r in rs]) * 1e3 if rs else np.zeros(0)
         err = sum(r["status"].startswith("error") for r in rs)
         succ = "{}/{} ({:.2f}-{:.2f})".format(ok, n, *wilson_interval(ok, n))
-        out.append(f"| {k[0]} | {k[1]} | {k[2]} | {succ} | {col} | {rc} | "
+        out.append(f"| {k[0]} | {k[1]} | {k[2]} | {succ} | {col} | {rc} | {rc_seen} | "
                    f"{min(md):.3f} | {np.mean(disc):.2f} | " if md else
-                   f"| {k[0]} | {k[1]} | {k[2]} | {succ} | {col} | {rc} | - | - | ")
+                   f"| {k[0]} | {k[1]} | {k[2]} | {succ} | {col} | {rc} | {rc_seen} | - | - | ")
         out[-1] += (f"{np.median(lb):.2f} | " if lb else "- | ")
         out[-1] += (f"{np.median(pt):.1f} / {np.percentile(pt, 95):.1f} | " if pt.size else "- | ")
         out[-1] += f"{err} |"

@@ -39,6 +39,18 @@ def test_pairs_two_files_and_lists_the_runs_that_differ(tmp_path, compare_rows, 
     assert "8 runs differ" in out and "w0 seed 0: new reached, old collision" in out
 
 
+def test_robot_caused_seen_in_time_leaves_out_obstacles_that_appeared_late(tmp_path, compare_rows, capsys):
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    rows = _rows("st-bitstar", ["collision*", "collision*", "reached"])
+    rows[0]["appeared_within_stop"] = True  # a person whose recorded track began on the robot
+    rows[1]["appeared_within_stop"] = False
+    a.write_text(json.dumps(rows))
+    b.write_text(json.dumps(_rows("st-bitstar", ["reached"] * 3)))
+    assert compare_rows.main([str(a), str(b)]) == 0
+    out = capsys.readouterr().out
+    assert "| robot-caused | 2 | 0 |" in out and "| robot-caused, seen in time | 1 | 0 |" in out
+
+
 def test_one_planner_per_file_pairs_across_names(tmp_path, compare_rows, capsys):
     a, b = tmp_path / "a.json", tmp_path / "b.json"
     a.write_text(json.dumps(_rows("st-bitstar", ["reached", "reached"])))
