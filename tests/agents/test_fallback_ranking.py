@@ -1,13 +1,17 @@
 """st-bitstar's fallback ranking: the approach speed counts every obstacle met within the
-reaction time, not only the first."""
+reaction time, not only the first; the staged ranking picks what ranking every candidate by
+its whole key picks."""
 
 from __future__ import annotations
 
 import math
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from anyplan.prediction import PredictedObstacle
+from anyplan.prediction.base import RadiusGrowth
 from anyplan.prediction.collision import predict_collisions
 from anyplan.trajectory import plan_motion
 from anyplan.world import RobotState, UnicycleMotion
@@ -49,3 +53,49 @@ def test_a_drive_grazed_first_then_into_a_standing_obstacle_ranks_as_driving_int
     k_brake, _ = agent._fallback_rank(brake, 0.0, [a, b], [a, b])
     assert k_brake[:4] == k_drive[:4]
     assert k_brake > k_drive
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(1, 8), v0=st.floats(0.0, 0.8),
+       grow=st.booleans(), passive=st.booleans())
+def test_staged_ranking_picks_what_ranking_every_candidate_by_its_whole_key_picks(seed, n, v0,
+                                                                                 grow, passive):
+    # best_fallback and freer_evasion compute each part of a candidate's key only when it can
+    # still decide (the lead parts, the first four, then the approach, then the clearance):
+    # the same choice, key and clearance as FallbackRanker.rank on every candidate, and the
+    # same answer of freer_evasion as comparing its motion's whole key with the best one.
+    from anyplan.agents.evasion import _best_ranked, freer_evasion
+    from anyplan.agents.safety import reachable_discs
+
+    agent = _agent_in_empty_room(v_max=1.0, omega_max=1.5, a_max=1.0, alpha_max=3.0)
+    rng = np.random.default_rng(seed)
+    growth = (RadiusGrowth(0.0, np.array([0.0, 1.0, 2.0, 4.0]), np.array([0.05, 0.3, 0.6, 1.0]))
+              if grow else None)
+    full = [PredictedObstacle(f"P{k}", 0.25,
+                              UnicycleMotion(*rng.uniform([2.0, 0.8], [10.0, 5.2]),
+                                             rng.uniform(-math.pi, math.pi), rng.uniform(0.0, 1.2)),
+                              growth, until=5.0 if grow else math.inf) for k in range(n)]
+    planned = agent._capped(full)
+    state = RobotState(6.0, 3.0, float(rng.uniform(-math.pi, math.pi)), v0, 0.0)
+    reach = (reachable_discs(full, 0.0, np.array([state.x, state.y]), state.theta, 0.2, 5.0)
+             if passive else [])
+    ranker = agent._ranker()
+    (key, clear), kind, tr = _best_ranked(ranker, 0.0, state, full, planned, None, None, reach)
+    cands = ranker.candidates(0.0, state, full)
+    ranked = [(ranker.rank(c, 0.0, full, planned, reach), k, c) for k, c in cands]
+    (k_all, clear_all), kind_all, tr_all = max(ranked, key=lambda c: c[0][0])
+    assert (key, clear, kind) == (k_all, clear_all, kind_all)
+    assert tr.t_end == tr_all.t_end and np.array_equal(tr.positions(np.array([0.5])),
+                                                       tr_all.positions(np.array([0.5])))
+    # freer_evasion, for a motion driving straight on (or the first candidate at rest)
+    motion = (plan_motion(np.array([[6.0, 3.0], [6.0 + 3.0 * math.cos(state.theta),
+                                                 3.0 + 3.0 * math.sin(state.theta)]]),
+                          agent.spec, state, agent.obstacles, 0.0, allow_turn=False)
+              if v0 > 0.1 else cands[0][1])
+    k_motion, _ = ranker.rank(motion, 0.0, full, planned, reach)
+    better = freer_evasion(ranker, 0.0, state, full, planned, motion, reach)
+    if k_all[:4] <= k_motion[:4]:
+        assert better is None
+    else:
+        assert better is not None and (better[0], better[2]) == (kind_all, clear_all)
+        assert better[1].t_end == tr_all.t_end

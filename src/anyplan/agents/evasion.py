@@ -182,32 +182,22 @@ class FallbackRanker:
         (:func:`_best_ranked`). The clearance search costs about as much as the contact
         search, and in a crowd most candidates are struck.
         """
-        guard = self.guard
-        cfg = guard.config
-        h = max(t + cfg.horizon_s, float(tr.t_end), t)
-        r = self.spec.radius
-        passive: tuple[bool, float] = (True, 0.0)
-        if reach:
-            esc = Escape(tr, t + self.commit_s, self.spec, self.obstacles, r)
-            ok = first_collision(esc, reach, r, t_from=t, t_until=max(esc.t_rest, t),
-                                 margin=cfg.margin, sample_dt=cfg.sample_dt) is None
-            # none passively safe: the one at rest soonest (the least exposure while moving)
-            passive = (ok, 0.0 if ok else -round(esc.t_rest - t, 2))
-        hit = first_collision(tr, planned, r, t_from=t, t_until=h, margin=cfg.margin,
-                              sample_dt=cfg.sample_dt)
-        clear: float | None = None
-        if lazy and hit is not None and self._struck_within_margin(tr, hit, full):
-            clear_ok = False
-        else:
-            clear = guard.clearance(tr, full, t, h)
-            clear_ok = clear >= cfg.margin
-        # the approach speed counts only for a contact within the reaction time
-        approach = (self._approach(tr, t, hit, planned)
-                    if hit is not None and float(hit.t) - t < self.react_s else 0.0)
-        return (bool(getattr(tr, "certified_free", True)), passive, clear_ok,
-                hit is None, -approach,
-                math.inf if hit is None else float(hit.t),
-                getattr(tr, "kind", None) != MotionKind.SWERVE), clear, h
+        key = _Key(self, tr, t, full, planned, reach)
+        if not lazy:
+            key.clearance()
+        return key.head(), key.clear, key.h
+
+    def _passive(self, tr: Any, t: float, reach: Sequence[PredictedObstacle]) -> tuple[bool, float]:
+        """The second part of :meth:`rank`'s key: ``tr`` passively safe against ``reach``
+        (True without it), or else how soon [s] its escape is at rest."""
+        if not reach:
+            return True, 0.0
+        cfg, r = self.guard.config, self.spec.radius
+        esc = Escape(tr, t + self.commit_s, self.spec, self.obstacles, r)
+        ok = first_collision(esc, reach, r, t_from=t, t_until=max(esc.t_rest, t),
+                             margin=cfg.margin, sample_dt=cfg.sample_dt) is None
+        # none passively safe: the one at rest soonest (the least exposure while moving)
+        return ok, 0.0 if ok else -round(esc.t_rest - t, 2)
 
     def _approach(self, tr: Any, t: float, hit: PredictedCollision,
                   planned: Sequence[PredictedObstacle]) -> float:
@@ -293,6 +283,93 @@ class FallbackRanker:
         return cands
 
 
+class _Key:
+    """The ranking key of one candidate (:meth:`FallbackRanker.head`), each part computed when
+    first asked for: the clearance and the contacts within the reaction time cost as much as
+    the first contact, and a candidate beaten on an earlier part never needs them."""
+
+    def __init__(self, ranker: FallbackRanker, tr: Any, t: float,
+                 full: Sequence[PredictedObstacle], planned: Sequence[PredictedObstacle],
+                 reach: Sequence[PredictedObstacle]) -> None:
+        cfg = ranker.guard.config
+        self.ranker, self.tr, self.t, self.full, self.planned = ranker, tr, t, full, planned
+        self.h = max(t + cfg.horizon_s, float(tr.t_end), t)
+        self.lead = (bool(getattr(tr, "certified_free", True)), ranker._passive(tr, t, reach))
+        self.clear: float | None = None
+        self._hit: tuple[PredictedCollision | None] | None = None
+        self._struck: bool | None = None
+        self._first4: tuple[Any, ...] | None = None
+        self._head: tuple[Any, ...] | None = None
+
+    def hit(self) -> PredictedCollision | None:
+        """The first contact with the planned discs over the horizon, or None."""
+        if self._hit is None:
+            cfg = self.ranker.guard.config
+            self._hit = (first_collision(self.tr, self.planned, self.ranker.spec.radius,
+                                         t_from=self.t, t_until=self.h, margin=cfg.margin,
+                                         sample_dt=cfg.sample_dt),)
+        return self._hit[0]
+
+    def clearance(self) -> float:
+        """The clearance [m] against the full discs over the horizon."""
+        if self.clear is None:
+            self.clear = self.ranker.guard.clearance(self.tr, self.full, self.t, self.h)
+        return self.clear
+
+    def struck(self) -> bool:
+        """True if the contact with a planned disc already says the clearance is below the
+        margin (:meth:`FallbackRanker._struck_within_margin`)."""
+        if self._struck is None:
+            hit = self.hit()
+            self._struck = hit is not None and self.ranker._struck_within_margin(self.tr, hit,
+                                                                                 self.full)
+        return self._struck
+
+    def bound4(self) -> tuple[Any, ...]:
+        """An upper bound of the key's first four parts, exact once :meth:`first4` ran or when
+        the contact says the clearance is below the margin."""
+        if self._first4 is not None or self.struck():
+            return self.first4()
+        return (*self.lead, True, self.hit() is None)
+
+    def first4(self) -> tuple[Any, ...]:
+        """The key's first four parts (clear of the static obstacles, passively safe, clear of
+        the full discs by the margin, free of the planned ones)."""
+        if self._first4 is None:
+            margin = self.ranker.guard.config.margin
+            # a clearance computed already decides (head(lazy=False)); else the contact may
+            clear_ok = (self.clear >= margin if self.clear is not None else
+                        not self.struck() and self.clearance() >= margin)
+            self._first4 = (*self.lead, clear_ok, self.hit() is None)
+        return self._first4
+
+    def head(self) -> tuple[Any, ...]:
+        """The key's first seven parts (all but the clearance)."""
+        if self._head is None:
+            ranker, tr, t, hit = self.ranker, self.tr, self.t, self.hit()
+            # the approach speed counts only for a contact within the reaction time
+            approach = (ranker._approach(tr, t, hit, self.planned)
+                        if hit is not None and float(hit.t) - t < ranker.react_s else 0.0)
+            self._head = (*self.first4(), -approach, math.inf if hit is None else float(hit.t),
+                          getattr(tr, "kind", None) != MotionKind.SWERVE)
+        return self._head
+
+
+def _top4(keys: list[_Key]) -> tuple[tuple[Any, ...], list[_Key]]:
+    """The best first four parts of ``keys`` and the keys that have them (in their order),
+    computed for those that can still have them only: the best two leading parts first, then
+    the others by their upper bound (:meth:`_Key.bound4`), best first."""
+    lead = max(k.lead for k in keys)
+    alive = [k for k in keys if k.lead == lead]
+    best: tuple[Any, ...] | None = None
+    for k in sorted(alive, key=_Key.bound4, reverse=True):  # stable: ties keep their order
+        if best is not None and k.bound4() < best:
+            break
+        best = k.first4() if best is None else max(best, k.first4())
+    assert best is not None
+    return best, [k for k in alive if k._first4 is not None and k._first4 == best]
+
+
 def best_fallback(ranker: FallbackRanker, t: float, state: RobotState,
                   full: Sequence[PredictedObstacle], planned: Sequence[PredictedObstacle],
                   motion: Any = None, current: Any = None,
@@ -308,21 +385,28 @@ def _best_ranked(ranker: FallbackRanker, t: float, state: RobotState,
                  full: Sequence[PredictedObstacle], planned: Sequence[PredictedObstacle],
                  motion: Any, current: Any, reach: Sequence[PredictedObstacle]
                  ) -> tuple[tuple[tuple[Any, ...], float], str, Any]:
+    """``((key, clearance [m]), kind, trajectory)`` of the best of the candidates (:func:`_best_of`)."""
+    cands = ranker.candidates(t, state, full, motion, current)
+    return _best_of([_Key(ranker, tr, t, full, planned, reach) for _, tr in cands],
+                    [kind for kind, _ in cands])
+
+
+def _best_of(keys: list[_Key], kinds: list[str]) -> tuple[tuple[tuple[Any, ...], float], str, Any]:
     """``((key, clearance [m]), kind, trajectory)`` of the best candidate (the first on a tie):
-    the best of the keys' first parts (:meth:`FallbackRanker.head`), then among the candidates
-    tied there the largest clearance, computed only for them: the same choice as ranking every
-    candidate by its whole key."""
-    heads = [(ranker.head(tr, t, full, planned, reach), kind, tr)
-             for kind, tr in ranker.candidates(t, state, full, motion, current)]
-    top = max(c[0][0] for c in heads)
+    the best of the keys' first four parts (:func:`_top4`), then the best of the first seven
+    among the candidates that have them (:meth:`_Key.head`), then among the candidates tied
+    there the largest clearance: the same choice as ranking every candidate by its whole key,
+    each part computed only for the candidates it can decide."""
+    _, tied = _top4(keys)
+    top = max(k.head() for k in tied)
+    at_top = {id(k) for k in tied if k.head() == top}
     best: tuple[float, str, Any] | None = None
-    for (head, clear, h), kind, tr in heads:
-        if head != top:
+    for k, kind in zip(keys, kinds, strict=True):  # in the candidates' order
+        if id(k) not in at_top:
             continue
-        if clear is None:
-            clear = ranker.guard.clearance(tr, full, t, h)
+        clear = k.clearance()
         if best is None or clear > best[0]:
-            best = (clear, kind, tr)
+            best = (clear, kind, k.tr)
     assert best is not None
     return ((*top, best[0]), best[0]), best[1], best[2]
 
@@ -339,10 +423,12 @@ def freer_evasion(ranker: FallbackRanker, t: float, state: RobotState,
     obstacle passes, a collision too (measured on the gap worlds with noise, where a slow robot
     waited in a walker's way). An evasion that no disc strikes is better.
     """
-    k_motion = ranker.head(motion, t, full, planned, reach)[0]
-    (k_best, clear), kind, tr = _best_ranked(ranker, t, state, full, planned, None, None, reach)
-    if k_best[:4] <= k_motion[:4]:
+    k_motion = _Key(ranker, motion, t, full, planned, reach).first4()
+    cands = ranker.candidates(t, state, full, None, None)
+    keys = [_Key(ranker, tr, t, full, planned, reach) for _, tr in cands]
+    if _top4(keys)[0] <= k_motion:
         return None
+    (_, clear), kind, tr = _best_of(keys, [kind for kind, _ in cands])
     return kind, tr, clear
 
 
