@@ -15,6 +15,8 @@ state, after ``t_end`` at its end pose with zero twist. See ``docs/motion.md``
 
 from __future__ import annotations
 
+import bisect
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -69,6 +71,18 @@ class CurveSegment(Segment):
         return self.curve.samples(step)
 
 
+def _span(flat: np.ndarray) -> tuple[float, float] | None:
+    """The earliest and the latest of the times ``flat`` [s], or None when there are none or
+    one is NaN (a few times in Python: cheaper than numpy's reductions)."""
+    if flat.size <= 16:
+        ts = flat.tolist()
+        if not ts or any(math.isnan(x) for x in ts):
+            return None
+        return min(ts), max(ts)
+    lo, hi = float(flat.min()), float(flat.max())
+    return None if math.isnan(lo) or math.isnan(hi) else (lo, hi)
+
+
 #: Segment types whose ``sample`` returns new arrays that share no memory.
 _FRESH = (CurveSegment, TurnSegment, BrakeSegment, SwerveSegment)
 
@@ -105,6 +119,7 @@ class Trajectory:
         self.certified_free = certified_free
         self.info = dict(info or {})
         self._starts = np.array([s.t0 for s in self.segments])
+        self._starts_list: list[float] = self._starts.tolist()
         self._path: np.ndarray | None = None  # built on first use (see path)
 
     @property
@@ -151,12 +166,19 @@ class Trajectory:
         flat = t.ravel()
         segs = self.segments
         nseg = len(segs)
-        if nseg == 1:
-            k0, single = 0, True
-        else:
+        span = _span(flat)
+        if span is None:  # no times, or a NaN among them: every segment found time by time
             idx = np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0, nseg - 1)
             k0 = int(idx[0]) if flat.size else 0
             single = flat.size > 0 and bool(np.all(idx == k0))
+        else:
+            # the segment index is monotone in time: one segment serves all when it serves the
+            # earliest and the latest (the index searchsorted(starts, t, "right") - 1, clipped)
+            k0 = min(max(bisect.bisect_right(self._starts_list, span[0]) - 1, 0), nseg - 1)
+            single = nseg == 1 or k0 == min(max(bisect.bisect_right(self._starts_list, span[1])
+                                                - 1, 0), nseg - 1)
+            if not single:
+                idx = np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0, nseg - 1)
         if single:
             # one segment serves every time (the common case: a control step or one query)
             seg = segs[k0]
@@ -173,10 +195,11 @@ class Trajectory:
                 vals = segs[k].sample(flat[m])
                 for o, val in zip(out, vals, strict=True):
                     o[m] = val
-        after = flat >= segs[-1].t1
-        if after.any():
-            out[3][after] = 0.0
-            out[4][after] = 0.0
+        if span is None or span[1] >= segs[-1].t1:  # at rest after the end
+            after = flat >= segs[-1].t1
+            if after.any():
+                out[3][after] = 0.0
+                out[4][after] = 0.0
         if t.ndim == 1:
             return out[0], out[1], out[2], out[3], out[4]
         return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
@@ -184,7 +207,10 @@ class Trajectory:
     def positions(self, t: np.ndarray | float) -> np.ndarray:
         """Reference positions (N, 2) [m] at absolute times ``t`` (N,) [s]."""
         x, y, _, _, _ = self.sample(np.atleast_1d(np.asarray(t, dtype=float)))
-        return np.column_stack([x.ravel(), y.ravel()])
+        p = np.empty((x.size, 2))
+        p[:, 0] = x.ravel()
+        p[:, 1] = y.ravel()
+        return p
 
     def state(self, t: float) -> RobotState:
         """The reference pose and twist at absolute time ``t`` [s]."""
