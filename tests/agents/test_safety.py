@@ -320,3 +320,37 @@ def test_decide_without_fallback_says_unsafe_and_logs_nothing():
     assert (d.kind, d.trajectory, d.safe) == ("unsafe", None, False)
     assert d.reason.startswith("proposed motion: collision predicted")
     assert guard.fallbacks == [] and guard.decisions == []
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(1, 12), nan=st.booleans())
+def test_threat_found_for_all_obstacles_at_once_is_the_one_found_one_at_a_time(seed, n, nan):
+    # SafetyGuard.candidates' threat (the obstacle nearest to the robot braking in place) is
+    # searched for every obstacle at once: bit for bit the direction of the search one obstacle
+    # at a time that keeps the first strictly nearer one, horizons, growth and NaN included.
+    from anyplan.agents.safety import _threat
+    from anyplan.prediction.base import RadiusGrowth
+
+    rng = np.random.default_rng(seed)
+    growth = RadiusGrowth(0.0, np.array([0.0, 2.0]), np.array([0.0, 0.5]))
+    preds = [PredictedObstacle(f"P{k}", float(rng.choice([0.2, 0.3])),
+                               UnicycleMotion(*rng.uniform(0.0, 8.0, 2), rng.uniform(-3.0, 3.0),
+                                              float(rng.choice([0.0, 0.5, 1.0]))),
+                               growth if rng.random() < 0.5 else None,
+                               until=float(rng.choice([math.inf, rng.uniform(-1.0, 6.0)])))
+             for k in range(n)]
+    ts = np.linspace(0.0, 5.0, 41)
+    pr = np.column_stack([np.linspace(4.0, 4.5, 41), np.full(41, 4.0)])
+    if nan:
+        pr[int(rng.integers(41)), 0] = math.nan
+    p_rest = pr[-1]
+    best, want = math.inf, None
+    for o in preds:
+        d = np.hypot(*(pr - o.positions(ts)).T) - float(getattr(o, "max_radius", o.radius))
+        d[ts > o.until] = math.inf
+        k = int(np.argmin(d))
+        if d[k] < best:
+            best, want = float(d[k]), o.positions(ts[k:k + 1])[0] - p_rest
+    got = _threat(preds, ts, pr, p_rest)
+    assert (got is None) == (want is None)
+    assert got is None or got.tobytes() == want.tobytes()

@@ -364,14 +364,7 @@ class SafetyGuard:
         p_rest = np.array([rest.x, rest.y])
         ts = np.linspace(t, h, 41)
         pr = hold.positions(ts)
-        best, u = math.inf, None
-        for o in preds:
-            d = np.hypot(*(pr - o.positions(ts)).T) - _max_radius(o)
-            d[ts > float(getattr(o, "until", math.inf))] = math.inf
-            k = int(np.argmin(d))
-            if d[k] < best:
-                best = float(d[k])
-                u = o.positions(ts[k:k + 1])[0] - p_rest
+        u = _threat(preds, ts, pr, p_rest)
         if u is None or math.hypot(*u) < 1e-9:
             return out
         u = u / math.hypot(*u)
@@ -430,6 +423,32 @@ def reachable_discs(preds: Sequence[PredictedObstacle], t: float, p: np.ndarray,
         out.append(PredictedObstacle(o.name, float(o.radius_at(t)),
                                      UnicycleMotion(float(q[0]), float(q[1]), 0.0, 0.0), growth))
     return out
+
+
+def _threat(preds: Sequence[PredictedObstacle], ts: np.ndarray, pr: np.ndarray,
+            p_rest: np.ndarray) -> np.ndarray | None:
+    """From ``p_rest`` [m] to the predicted obstacle that comes nearest (centre distance less
+    its largest radius) to the robot at ``pr`` (len(ts), 2) [m] at times ``ts`` [s], where it
+    is then (the first such obstacle and time; None if none is predicted at ``ts``)."""
+    u: np.ndarray | None = None
+    # every obstacle at once, element by element the operations of a search one obstacle at
+    # a time that keeps the first strictly nearer one
+    q = np.stack([np.asarray(o.positions(ts), dtype=float) for o in preds])
+    d = np.hypot(pr[None, :, 0] - q[:, :, 0], pr[None, :, 1] - q[:, :, 1]) \
+        - np.array([_max_radius(o) for o in preds])[:, None]
+    d[ts[None, :] > np.array([float(getattr(o, "until", math.inf)) for o in preds])[:, None]] \
+        = math.inf
+    k = np.argmin(d, axis=1)
+    dk = d[np.arange(len(preds)), k]
+    if np.isnan(dk).any():  # NaN never wins the comparison one at a time: as there
+        best = math.inf
+        for i, di in enumerate(dk.tolist()):
+            if di < best:
+                best, u = di, preds[i].positions(ts[k[i]:k[i] + 1])[0] - p_rest
+    elif float(dk.min()) < math.inf:
+        i = int(np.argmin(dk))
+        u = preds[i].positions(ts[k[i]:k[i] + 1])[0] - p_rest
+    return u
 
 
 #: Predictions on a time grid: centres (n, T, 2), largest radii, speed bounds, horizons.
