@@ -99,3 +99,24 @@ def test_staged_ranking_picks_what_ranking_every_candidate_by_its_whole_key_pick
     else:
         assert better is not None and (better[0], better[2]) == (kind_all, clear_all)
         assert better[1].t_end == tr_all.t_end
+
+
+def test_the_guard_caps_the_predictions_into_the_planning_s_own_objects():
+    # _capped keeps its last answer: the guard, capping the predictions the planning capped,
+    # gets the same objects (the contact searches' caches of prediction sets serve both),
+    # each equal to one capped anew; other predictions are capped anew.
+    agent = _agent_in_empty_room()
+    growth = RadiusGrowth(0.0, np.array([0.0, 2.0, 4.0]), np.array([0.0, 1.0, 2.0]))
+    full = [PredictedObstacle(f"P{k}", 0.25, UnicycleMotion(2.0 + k, 3.0, 0.5 * k, 0.8),
+                              growth if k % 2 else None, until=5.0) for k in range(5)]
+    planned = agent._capped(full)
+    again = agent._capped(list(full))
+    assert again is not planned and all(a is b for a, b in zip(again, planned, strict=True))
+    c = agent.plan_extra_m
+    for o, p in zip(full, planned, strict=True):
+        assert (p is o) == (o.growth is None or o.growth.max_extra <= c)
+        if p is not o:
+            assert p.growth.values.tobytes() == o.growth.capped(c).values.tobytes()
+            assert (p.name, p.radius, p.motion, p.until) == (o.name, o.radius, o.motion, o.until)
+    other = [PredictedObstacle("P1", 0.25, full[1].motion, growth, until=5.0)]
+    assert agent._capped(other)[0] is not planned[1]

@@ -40,6 +40,8 @@ class PlanningPredictions:
     guard_mode: str
     plan_extra_m: float | None
     announced_horizon_s: float | None
+    #: :meth:`_capped`'s last answer: (cap [m], its predictions, the capped ones).
+    _capped_memo: tuple[float, tuple[PredictedObstacle, ...], list[PredictedObstacle]] | None = None
 
     def _planning_preds(self, preds: list[PredictedObstacle], p: np.ndarray,
                         t: float) -> list[PredictedObstacle]:
@@ -120,9 +122,18 @@ class PlanningPredictions:
         c = self.plan_extra_m
         if c is None:
             return preds
-        return [o if o.growth is None or o.growth.max_extra <= c else
-                PredictedObstacle(o.name, o.radius, o.motion, o.growth.capped(c), o.until)
-                for o in preds]
+        # The last answer is kept: the safety guard caps the predictions the planning capped
+        # (the same objects, so the contact searches' caches of prediction sets serve both;
+        # the entry holds them, so an ``id`` seen here is the same live object).
+        memo = self._capped_memo
+        if memo is not None and memo[0] == c and len(memo[1]) == len(preds) and all(
+                a is b for a, b in zip(memo[1], preds, strict=True)):
+            return list(memo[2])
+        out = [o if o.growth is None or o.growth.max_extra <= c else
+               PredictedObstacle(o.name, o.radius, o.motion, o.growth.capped(c), o.until)
+               for o in preds]
+        self._capped_memo = (c, tuple(preds), out)
+        return list(out)
 
     def _trapped(self, preds: list[PredictedObstacle], state: RobotState, t: float) -> bool:
         """Whether a planned disc holds every place the robot can reach from ``state`` at
