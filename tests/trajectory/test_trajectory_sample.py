@@ -1,6 +1,7 @@
-"""Trajectory.sample finds the segment that serves all times from their earliest and latest:
-bit for bit the answer of finding every time's segment (searchsorted), on random trajectories
-of several segments and random times (sorted or not, on segment starts, after the end, NaN)."""
+"""Trajectory.sample finds the segment that serves all times from their earliest and latest,
+and the segments' slices of times in order: bit for bit the answer of finding every time's
+segment (searchsorted), on random trajectories of several segments and random times (sorted or
+not, on segment starts, after the end, NaN)."""
 
 from __future__ import annotations
 
@@ -38,7 +39,7 @@ def _reference(tr: Trajectory, t: np.ndarray) -> list[np.ndarray]:
 
 @settings(max_examples=40, deadline=None)
 @given(kind=st.sampled_from(["turn+curve", "swerve"]), seed=st.integers(0, 10_000),
-       n=st.integers(0, 40), order=st.sampled_from(["sorted", "random", "starts"]),
+       n=st.integers(0, 40), order=st.sampled_from(["sorted", "random", "starts", "starts sorted"]),
        nan=st.booleans())
 def test_sample_equals_the_time_by_time_segment_lookup(kind, seed, n, order, nan):
     rng = np.random.default_rng(seed)
@@ -53,8 +54,10 @@ def test_sample_equals_the_time_by_time_segment_lookup(kind, seed, n, order, nan
         tr = plan_motion(np.array([[0.0, 0.0], [4.0, float(rng.uniform(-3.0, 3.0))]]), SPEC, state,
                          free, 1.0)
     lo, hi = tr.t_start - 0.5, tr.t_end + 0.5
-    if order == "starts":  # on the segments' starts and ends, and between
+    if order.startswith("starts"):  # on the segments' starts and ends, and between
         t = np.concatenate([[s.t0 for s in tr.segments], [tr.t_end], rng.uniform(lo, hi, n)])
+        if order == "starts sorted":
+            t = np.sort(t)
     else:
         t = rng.uniform(lo, hi, n)
         if order == "sorted":

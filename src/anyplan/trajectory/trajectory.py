@@ -83,6 +83,14 @@ def _span(flat: np.ndarray) -> tuple[float, float] | None:
     return None if math.isnan(lo) or math.isnan(hi) else (lo, hi)
 
 
+def _ascending(flat: np.ndarray) -> bool:
+    """Whether the times ``flat`` [s] (no NaN) are in nondecreasing order."""
+    if flat.size <= 16:
+        ts = flat.tolist()
+        return all(a <= b for a, b in zip(ts, ts[1:], strict=False))
+    return bool(np.all(flat[1:] >= flat[:-1]))
+
+
 #: Segment types whose ``sample`` returns new arrays that share no memory.
 _FRESH = (CurveSegment, TurnSegment, BrakeSegment, SwerveSegment)
 
@@ -167,6 +175,7 @@ class Trajectory:
         segs = self.segments
         nseg = len(segs)
         span = _span(flat)
+        cuts: list[int] | None = None
         if span is None:  # no times, or a NaN among them: every segment found time by time
             idx = np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0, nseg - 1)
             k0 = int(idx[0]) if flat.size else 0
@@ -177,7 +186,9 @@ class Trajectory:
             k0 = min(max(bisect.bisect_right(self._starts_list, span[0]) - 1, 0), nseg - 1)
             single = nseg == 1 or k0 == min(max(bisect.bisect_right(self._starts_list, span[1])
                                                 - 1, 0), nseg - 1)
-            if not single:
+            cuts = None if single or not _ascending(flat) else \
+                [0, *np.searchsorted(flat, self._starts[1:], side="left").tolist(), flat.size]
+            if not single and cuts is None:
                 idx = np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0, nseg - 1)
         if single:
             # one segment serves every time (the common case: a control step or one query)
@@ -188,6 +199,16 @@ class Trajectory:
                 out = [np.asarray(v, dtype=float).reshape(flat.shape) for v in vals]
             else:
                 out = [np.array(v, dtype=float).reshape(flat.shape) for v in vals]
+        elif cuts is not None:
+            # times in order: segment k serves the slice from the first time at or after its
+            # start to the first at or after the next one's (searchsorted(starts, t, "right") - 1)
+            out = [np.empty(flat.shape) for _ in range(5)]
+            for k in range(nseg):
+                lo, hi = cuts[k], cuts[k + 1]
+                if lo < hi:
+                    vals = segs[k].sample(flat[lo:hi])
+                    for o, val in zip(out, vals, strict=True):
+                        o[lo:hi] = val
         else:
             out = [np.empty(flat.shape) for _ in range(5)]
             for k in np.unique(idx):
