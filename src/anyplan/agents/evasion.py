@@ -139,6 +139,11 @@ class FallbackRanker:
         #: still come to rest before it: one check period on the candidate, braking from top
         #: speed, and the next decision's own check period (issue 10's invariant).
         self.react_s = 2.0 * self.commit_s + spec.v_max / max(spec.a_max, 1e-9)
+        #: The full discs of the last ranking: (their list, its length, the first disc of each
+        #: name, their largest speed bound [m/s] once asked for); the list is not changed
+        #: while it is ranked against.
+        self._full_memo: tuple[Sequence[PredictedObstacle], int, dict[str, PredictedObstacle],
+                               float | None] | None = None
 
     def rank(self, tr: Any, t: float, full: Sequence[PredictedObstacle],
              planned: Sequence[PredictedObstacle], reach: Sequence[PredictedObstacle] = ()
@@ -222,12 +227,24 @@ class FallbackRanker:
         clearance :meth:`~anyplan.agents.safety.SafetyGuard.clearance` returns, at most the
         least distance plus that accuracy, is then below the margin too."""
         cfg = self.guard.config
-        o = next((o for o in full if o.name == hit.obstacle), None)
+        memo = self._full_memo
+        if memo is None or memo[0] is not full or memo[1] != len(full):
+            # the first of each name, and the largest speed bound [m/s]: once per ranking (the
+            # candidates of one ranking are struck by the same discs)
+            first: dict[str, PredictedObstacle] = {}
+            for p in full:
+                first.setdefault(p.name, p)
+            memo = self._full_memo = (full, len(full), first, None)
+        o = memo[2].get(hit.obstacle)
         if o is None:
             return False
         gap = (math.hypot(*(np.asarray(hit.robot_position) - np.asarray(hit.obstacle_position)))
                - self.spec.radius - float(getattr(o, "max_radius", o.radius)))
-        speed = float(tr.max_speed) + max(float(p.max_speed) for p in full)
+        vmax = memo[3]
+        if vmax is None:
+            vmax = max(float(p.max_speed) for p in full)
+            self._full_memo = (*memo[:3], vmax)
+        speed = float(tr.max_speed) + vmax
         return gap + speed * cfg.tol < cfg.margin
 
     def candidates(self, t: float, state: RobotState, safe: Sequence[PredictedObstacle],

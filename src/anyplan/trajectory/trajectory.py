@@ -129,6 +129,7 @@ class Trajectory:
         self._starts = np.array([s.t0 for s in self.segments])
         self._starts_list: list[float] = self._starts.tolist()
         self._path: np.ndarray | None = None  # built on first use (see path)
+        self._max_speed: float | None = None  # taken on first use (see max_speed)
 
     @property
     def t_start(self) -> float:
@@ -147,8 +148,11 @@ class Trajectory:
 
     @property
     def max_speed(self) -> float:
-        """Upper bound on |d position / dt| [m/s] over all time (for certified contact tests)."""
-        return max(s.max_speed for s in self.segments)
+        """Upper bound on |d position / dt| [m/s] over all time (for certified contact tests);
+        the segments' bound, taken on first use (segments do not change once built)."""
+        if self._max_speed is None:
+            self._max_speed = max(s.max_speed for s in self.segments)
+        return self._max_speed
 
     @property
     def length(self) -> float:
