@@ -254,3 +254,34 @@ def test_rows_of_one_motion_are_shared_whatever_its_predictions_end():
         at = PredictedObstacle("X", 0.3, motion, until=until).radius_at
         r_ref = np.maximum(at(starts + 0.025), np.maximum(at(ends[:-1]), at(ends[1:])))
         assert np.array_equal(r[0], r_ref)
+
+
+def test_cached_rows_are_bit_for_bit_the_rows_sampled_one_obstacle_at_a_time():
+    # RowCache samples the row times once for all the new entries of a stack (and radii_at
+    # copies a radius array of the right shape without broadcasting): each obstacle's rows are
+    # still its centres at the rows' middles and its largest radius at their edges and middles,
+    # bit for bit, for fixed, growing and ending discs over growing ranges.
+    from anyplan.prediction.base import RadiusGrowth
+    from anyplan.trajectory.spacetime import radii_at
+
+    growth = RadiusGrowth(1.0, np.array([0.0, 2.0, 5.0]), np.array([0.0, 0.4, 1.0]))
+    obs = [PredictedObstacle("A", 0.3, UnicycleMotion(5.0, -1.3, np.pi / 2, 0.3)),
+           PredictedObstacle("B", 0.25, UnicycleMotion(3.0, 5.0, -1.0, 0.7), growth, until=6.0),
+           PredictedObstacle("C", 0.2, UnicycleMotion(1.0, 1.0, 0.3, 1.1, 0.4), growth),
+           Growing("G", UnicycleMotion(3.0, 5.0, -np.pi / 2, 0.2), 0.3, 0.02)]
+    rows = RowCache(1.0, 0.05)
+    for j0, j1 in ((0, 300), (10, 700), (0, 120), (5, 1500)):
+        qx, qy, r = rows.rows_all(obs, j0, j1)
+        j = np.arange(j0, j1)
+        t_mid = 1.0 + 0.05 * (j + 0.5)
+        t_edges = 1.0 + 0.05 * np.arange(j0, j1 + 1)
+        for k, o in enumerate(obs):
+            q = o.positions(t_mid)
+            re = np.broadcast_to(np.asarray(o.radius_at(t_edges), dtype=float), t_edges.shape)
+            rm = np.broadcast_to(np.asarray(o.radius_at(t_mid), dtype=float), t_mid.shape)
+            want = np.maximum(rm, np.maximum(re[:-1], re[1:]))
+            if isinstance(o, PredictedObstacle) and o.growth is None:  # fixed size, then its end
+                want = np.where(1.0 + 0.05 * j <= o.until, o.radius, -np.inf)
+            assert qx[k].tobytes() == q[:, 0].tobytes() and qy[k].tobytes() == q[:, 1].tobytes()
+            assert r[k].tobytes() == want.tobytes()
+            assert radii_at(o, t_mid).tobytes() == rm.tobytes()

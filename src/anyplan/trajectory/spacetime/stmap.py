@@ -33,7 +33,8 @@ def radii_at(obstacle: Any, t: np.ndarray) -> np.ndarray:
     t = np.asarray(t, dtype=float)
     fn = getattr(obstacle, "radius_at", None)
     if callable(fn):
-        return np.broadcast_to(np.asarray(fn(t), dtype=float), t.shape).copy()
+        r = np.asarray(fn(t), dtype=float)
+        return r.copy() if r.shape == t.shape else np.broadcast_to(r, t.shape).copy()
     return np.full(t.shape, float(obstacle.radius))
 
 
@@ -137,6 +138,7 @@ class RowCache:
         self._stack: tuple[list[Any], int, int, np.ndarray, np.ndarray, np.ndarray] | None = None
         self._j_begin = 0
         self._used: set[int] = set()
+        self._times_memo: tuple[int, int, np.ndarray, np.ndarray] | None = None
 
     def on_grid(self, t: float) -> bool:
         """Whether time ``t`` [s] is a row boundary of this grid (to 1e-9 of a row)."""
@@ -184,18 +186,25 @@ class RowCache:
             else:  # (rows before this replanning's start are not kept)
                 a = min(max(e[1], self._j_begin), j0)
                 b = max(e[2] + (e[2] - a), j1)
-            j = np.arange(a, b)
-            t_mid = self.t_origin + self.h * (j + 0.5)
+            t_mid, t_edges = self._times(a, b)
             q = np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2)
             if size is not None:  # fixed size: the end is applied below
-                r_max = np.full(len(j), size)
+                r_max = np.full(len(t_mid), size)
             else:
-                t_edges = self.t_origin + self.h * np.arange(a, b + 1)
                 r_edge = radii_at(o, t_edges)
                 r_max = np.maximum(radii_at(o, t_mid), np.maximum(r_edge[:-1], r_edge[1:]))
             e = (holder, a, b, q, r_max, size)
             self._rows[key] = e
         return e[3][j0 - e[1]:j1 - e[1]], e[4][j0 - e[1]:j1 - e[1]], until
+
+    def _times(self, a: int, b: int) -> tuple[np.ndarray, np.ndarray]:
+        """The middles (b - a,) and the edges (b - a + 1,) [s] of rows a .. b - 1; the last
+        answer is kept (the new entries of one stack are all asked for the same rows)."""
+        if self._times_memo is None or self._times_memo[:2] != (a, b):
+            t_mid = self.t_origin + self.h * (np.arange(a, b) + 0.5)
+            t_edges = self.t_origin + self.h * np.arange(a, b + 1)
+            self._times_memo = (a, b, t_mid, t_edges)
+        return self._times_memo[2], self._times_memo[3]
 
     def rows_all(self, obstacles: Sequence[Any], j0: int, j1: int
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
