@@ -757,7 +757,7 @@ def test_a_planning_call_books_its_safety_decision_too(monkeypatch):
 @given(seed=st.integers(0, 10_000), n=st.integers(1, 6), v0=st.floats(0.0, 0.4))
 def test_lazy_fallback_ranking_picks_what_ranking_every_candidate_picks(seed, n, v0):
     # _best_ranked skips the clearance of candidates the planned discs strike within the margin
-    # (FallbackRanker.head) and computes it only on a tie: the same candidate, key and
+    # (the struck test of its staged key) and computes it only on a tie: the same candidate, key and
     # clearance as ranking every candidate by its whole key (FallbackRanker.rank).
     from anyplan.agents.evasion import _best_ranked
     from anyplan.prediction import PredictedObstacle

@@ -169,28 +169,9 @@ class FallbackRanker:
         short of that contact; the approach speed of so distant a contact says nothing of what
         the robot will do).
         """
-        head, clear, _ = self.head(tr, t, full, planned, reach, lazy=False)
-        assert clear is not None
-        return (*head, clear), clear
-
-    def head(self, tr: Any, t: float, full: Sequence[PredictedObstacle],
-             planned: Sequence[PredictedObstacle], reach: Sequence[PredictedObstacle] = (),
-             lazy: bool = True) -> tuple[tuple[Any, ...], float | None, float]:
-        """The first seven parts of :meth:`rank`'s key (all but the clearance), the clearance
-        [m] against the ``full`` discs when it was computed (None otherwise) and the end [s]
-        of the horizon it is taken over.
-
-        ``lazy``: a candidate the ``planned`` discs strike within the margin is not clear of
-        the full ones by it (they hold the planned ones), so its clearance is not computed
-        when the struck disc's full size at the contact already says so
-        (:meth:`_struck_within_margin`); only a tie on these parts needs it
-        (:func:`_best_ranked`). The clearance search costs about as much as the contact
-        search, and in a crowd most candidates are struck.
-        """
         key = _Key(self, tr, t, full, planned, reach)
-        if not lazy:
-            key.clearance()
-        return key.head(), key.clear, key.h
+        clear = key.clearance()  # computed first: the key's third part then reads it
+        return (*key.head(), clear), clear
 
     def _passive(self, tr: Any, t: float, reach: Sequence[PredictedObstacle]) -> tuple[bool, float]:
         """The second part of :meth:`rank`'s key: ``tr`` passively safe against ``reach``
@@ -301,9 +282,12 @@ class FallbackRanker:
 
 
 class _Key:
-    """The ranking key of one candidate (:meth:`FallbackRanker.head`), each part computed when
+    """The ranking key of one candidate (:meth:`FallbackRanker.rank`), each part computed when
     first asked for: the clearance and the contacts within the reaction time cost as much as
-    the first contact, and a candidate beaten on an earlier part never needs them."""
+    the first contact, and a candidate beaten on an earlier part never needs them. A candidate
+    the planned discs strike within the margin is not clear of the full ones by it (they hold
+    the planned ones): its clearance is then not needed for the key's first four parts
+    (:meth:`struck`), only for a final tie (:func:`_best_of`)."""
 
     def __init__(self, ranker: FallbackRanker, tr: Any, t: float,
                  full: Sequence[PredictedObstacle], planned: Sequence[PredictedObstacle],
@@ -354,7 +338,7 @@ class _Key:
         the full discs by the margin, free of the planned ones)."""
         if self._first4 is None:
             margin = self.ranker.guard.config.margin
-            # a clearance computed already decides (head(lazy=False)); else the contact may
+            # a clearance computed already decides (rank); else the contact may, without it
             clear_ok = (self.clear >= margin if self.clear is not None else
                         not self.struck() and self.clearance() >= margin)
             self._first4 = (*self.lead, clear_ok, self.hit() is None)
