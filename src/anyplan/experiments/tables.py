@@ -109,23 +109,45 @@ class PlannerTable:
         return self.planner + (f" [{self.settings}]" if self.settings else "")
 
 
+#: The tables' order: the paper's planners first, then by name and settings.
+_ORDER = {"seq-bitstar": 0, "bitstar": 1, "dovs": 2}
+
+
+def _configs(runs: Sequence[Mapping[str, Any]]
+             ) -> list[tuple[tuple[str, str], list[Mapping[str, Any]]]]:
+    """The rows of each planner configuration ``(planner, settings)``, in the tables' order;
+    rows without ``outcome`` or ``n_moving`` (e.g. imported OMPL runs) are left out."""
+    groups: dict[tuple[str, str], list[Mapping[str, Any]]] = {}
+    for r in runs:
+        if r.get("outcome") is None or r.get("n_moving") is None:
+            continue
+        groups.setdefault((str(r["planner"]), str(r.get("settings") or "")), []).append(r)
+    return sorted(groups.items(), key=lambda g: (_ORDER.get(g[0][0], 9), g[0][0], g[0][1]))
+
+
+def _reached(r: Mapping[str, Any]) -> bool:
+    return bool(r["outcome"] == "reached")
+
+
+def _robot_caused(r: Mapping[str, Any]) -> bool:
+    """A collision in which the robot drove into what it hit (``robot_caused``)."""
+    return r["outcome"] == "collision" and bool(r.get("robot_caused"))
+
+
 def summarize(runs: Sequence[Mapping[str, Any]]) -> list[PlannerTable]:
     """Tables from run rows as returned by :meth:`ResultsDB.runs`.
 
     Rows without ``outcome`` or ``n_moving`` (e.g. imported OMPL runs) are ignored.
     """
-    groups: dict[tuple[str, str], dict[int, list[Mapping[str, Any]]]] = {}
-    for r in runs:
-        if r.get("outcome") is None or r.get("n_moving") is None:
-            continue
-        key = (str(r["planner"]), str(r.get("settings") or ""))
-        groups.setdefault(key, {}).setdefault(int(r["n_moving"]), []).append(r)
     tables = []
-    for (name, settings), by_n in groups.items():
+    for (name, settings), rows in _configs(runs):
+        by_n: dict[int, list[Mapping[str, Any]]] = {}
+        for r in rows:
+            by_n.setdefault(int(r["n_moving"]), []).append(r)
         t = PlannerTable(name, settings)
         for n in sorted(by_n):
             rs = by_n[n]
-            ok = [r for r in rs if r["outcome"] == "reached"]
+            ok = [r for r in rs if _reached(r)]
             t.rows.append(TableRow(
                 n_moving=n, runs=len(rs), successes=len(ok),
                 crashes=sum(r["outcome"] == "collision" for r in rs),
@@ -135,16 +157,13 @@ def summarize(runs: Sequence[Mapping[str, Any]]) -> list[PlannerTable]:
                 generation_time=Stat.of(r.get("planning_time_mean") for r in rs
                                         if (r.get("planning_calls") or 0) > 0),
                 time_to_goal=Stat.of(r["time_to_goal"] for r in ok),
-                robot_caused=sum(bool(r.get("robot_caused")) for r in rs
-                                 if r["outcome"] == "collision"),
+                robot_caused=sum(_robot_caused(r) for r in rs),
                 time_over_bound=Stat.of(r.get("time_over_lower_bound") for r in ok),
                 min_distance_to_moving=min((r["min_distance_to_moving"] for r in rs
                                             if r.get("min_distance_to_moving") is not None),
                                            default=math.nan),
                 discomfort_time=Stat.of(r.get("discomfort_time") for r in rs)))
         tables.append(t)
-    order = {"seq-bitstar": 0, "bitstar": 1, "dovs": 2}
-    tables.sort(key=lambda t: (order.get(t.planner, 9), t.planner, t.settings))
     return tables
 
 
@@ -173,30 +192,20 @@ def compare_planners(runs: Sequence[Mapping[str, Any]], level: float = 0.95) -> 
     """Every pair of planner configurations in ``runs`` (rows as for :func:`summarize`) that
     share at least one run, in the order of :func:`summarize`'s tables. Errors count as not
     reached; a run key stored twice for one configuration keeps its last row."""
-    by_config: dict[str, dict[tuple[Any, ...], Mapping[str, Any]]] = {}
-    for t in summarize(runs):
-        by_config[t.title] = {}
-    for r in runs:
-        if r.get("outcome") is None or r.get("n_moving") is None:
-            continue
-        title = PlannerTable(str(r["planner"]), str(r.get("settings") or "")).title
-        by_config[title][_run_key(r)] = r
-    titles = list(by_config)
+    configs = [(PlannerTable(name, settings).title, {_run_key(r): r for r in rows})
+               for (name, settings), rows in _configs(runs)]
+
+    def paired(ra: Mapping[Any, Mapping[str, Any]], rb: Mapping[Any, Mapping[str, Any]],
+               outcome: Any) -> PairedComparison:
+        return compare_outcomes({k: outcome(r) for k, r in ra.items()},
+                                {k: outcome(r) for k, r in rb.items()}, level)
+
     pairs = []
-    for i, ta in enumerate(titles):
-        for tb in titles[i + 1:]:
-            ra, rb = by_config[ta], by_config[tb]
-            if not any(k in rb for k in ra):
-                continue
-
-            def outcome(rs: Mapping[Any, Mapping[str, Any]], caused: bool) -> dict[Any, bool]:
-                if not caused:
-                    return {k: r["outcome"] == "reached" for k, r in rs.items()}
-                return {k: r["outcome"] == "collision" and bool(r.get("robot_caused"))
-                        for k, r in rs.items()}
-
-            pairs.append(PlannerPair(ta, tb, compare_outcomes(outcome(ra, False), outcome(rb, False), level),
-                                     compare_outcomes(outcome(ra, True), outcome(rb, True), level)))
+    for i, (ta, ra) in enumerate(configs):
+        for tb, rb in configs[i + 1:]:
+            if any(k in rb for k in ra):
+                pairs.append(PlannerPair(ta, tb, paired(ra, rb, _reached),
+                                         paired(ra, rb, _robot_caused)))
     return pairs
 
 
