@@ -26,19 +26,21 @@ from typing import Any
 
 from anyplan.experiments.significance import compare_outcomes
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from unknown import robot_caused, seen_in_time  # the rows' own predicates
+
 Row = dict[str, Any]
 
 
 class BadInput(Exception):
     """A file that cannot be compared: one line, exit code 2."""
 
+
 OUTCOMES: dict[str, Callable[[Row], bool]] = {
     "reached": lambda r: r["status"] == "reached",
     "collided": lambda r: r["status"] == "collision",
-    "robot-caused": lambda r: r["status"] == "collision" and bool(r.get("robot_caused")),
-    # ... with an obstacle there for longer than the robot's stopping time (unknown.py's column)
-    "robot-caused, seen in time": lambda r: (r["status"] == "collision" and bool(r.get("robot_caused"))
-                                             and r.get("appeared_within_stop") is not True),
+    "robot-caused": robot_caused,
+    "robot-caused, seen in time": seen_in_time,  # unknown.py's column
 }
 
 
@@ -53,7 +55,7 @@ def _load(path: str) -> list[Row]:
     if not isinstance(rows, list) or not all(isinstance(r, dict) and all(k in r for k in need)
                                              for r in rows):
         raise BadInput(f"{path}: not a --rows file of benchmarks/unknown.py "
-                         f"(a list of runs with {', '.join(need)})")
+                       f"(a list of runs with {', '.join(need)})")
     return rows
 
 
@@ -79,7 +81,7 @@ def _groups(a: list[Row], b: list[Row],
 
 def _tag(r: Row) -> str:
     if r["status"] == "collision":
-        return "collision (robot-caused)" if r.get("robot_caused") else "collision"
+        return "collision (robot-caused)" if robot_caused(r) else "collision"
     return str(r["status"])
 
 

@@ -187,11 +187,15 @@ def _prediction_dynabarn(worlds: list[int], tracker: tuple[tuple[str, float], ..
     return "\n".join(lines)
 
 
-def _seen_in_time(r: dict[str, Any]) -> bool:
+def robot_caused(r: dict[str, Any]) -> bool:
+    """A run (a ``--rows`` row) that ended in a collision the robot drove into."""
+    return r["status"] == "collision" and bool(r.get("robot_caused"))
+
+
+def seen_in_time(r: dict[str, Any]) -> bool:
     """A robot-caused collision with an obstacle that had been there for longer than the robot
     needs to stop (``appeared_within_stop`` false or unknown): one a planner could have avoided."""
-    return (r["status"] == "collision" and bool(r.get("robot_caused"))
-            and r.get("appeared_within_stop") is not True)
+    return robot_caused(r) and r.get("appeared_within_stop") is not True
 
 
 def _table(rows: list[dict[str, Any]]) -> str:
@@ -207,8 +211,8 @@ def _table(rows: list[dict[str, Any]]) -> str:
         n = len(rs)
         ok = sum(r["status"] == "reached" for r in rs)
         col = sum(r["status"] == "collision" for r in rs)
-        rc = sum(r["status"] == "collision" and r.get("robot_caused") for r in rs)
-        rc_seen = sum(_seen_in_time(r) for r in rs)
+        rc = sum(robot_caused(r) for r in rs)
+        rc_seen = sum(seen_in_time(r) for r in rs)
         md = [r["min_dist"] for r in rs if r.get("min_dist") is not None]
         disc = [r["discomfort"] for r in rs if r.get("discomfort") is not None]
         lb = [r["t_over_lb"] for r in rs if r.get("t_over_lb") is not None and r["status"] == "reached"]
