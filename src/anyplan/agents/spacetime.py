@@ -106,8 +106,11 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             the full growth (free to rest, or stoppable) before it starts. None: no cap.
         guard: ``"growth"``: the horizon and the guard apply to uncertain discs (``tracked``),
             exact twists (``twist``) are planned against in full; ``"horizon"``: both apply to
-            every prediction without an announced motion; ``"never"``: the horizon without the
-            guard.
+            every prediction without an announced motion; ``"never"``: the horizon alone.
+        outrun_margin_mps: An uncertain obstacle predicted slower than ``v_max`` minus this
+            [m/s] is outrun: the guard checks its planned disc, and none when every obstacle in
+            view is outrun (``docs/perception.md``, "Which obstacles the guard checks in full";
+            1/3 m/s: fleeing gains the 1 m growth cap in the 3 s horizon). None: all in full.
         manoeuvre_accel: A manoeuvre allowance [m/s^2] for exact twists (``twist``): their
             discs grow by ``manoeuvre_accel tau^2 / 2`` up to 1 m (uncertain, so the horizon and
             the guard apply as to tracked ones). 0: planned against in full (the default).
@@ -123,10 +126,9 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         swerves: Among the fallbacks, also arcs entered at the robot's speed, then a brake
             (:data:`~anyplan.agents.evasion.SWERVES`), when no prediction is uncertain (exact
             twists, announced motions): a differential-drive robot that turns in place first
-            stands in the obstacle's way. Measured on DynaBARN 20-59, ``twist``, seeds 0-9:
-            339/400 reached with 31 robot-caused collisions, against 323/400 and 33 without;
-            among uncertain discs (``tracked``) they added robot-caused collisions (17 -> 25-28
-            of 200) and are not offered (``docs/perception.md``).
+            stands in the obstacle's way. Measured (``docs/perception.md``, "Fallbacks"): on
+            DynaBARN ``twist`` 339/400 reached against 323/400 without; among uncertain discs
+            they added robot-caused collisions and are not offered.
         twist_check_period_s: How often [s] the motion in use is checked while the obstacles
             in view are predicted from their exact current twists (``twist`` perception: no
             announced motion, no uncertain disc). Each check is the robot's next chance to
@@ -134,9 +136,8 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             commitment of the fallbacks and enters their reaction time. Otherwise
             ``check_period_s`` (0.2 s) applies: with announced motions predictions do not
             change, and with tracked obstacles 0.1 s was measured no better. None:
-            ``check_period_s`` always. Measured on DynaBARN 20-59, ``twist``, seeds 0-4
-            (``docs/perception.md``): 161/200 reached with 15 robot-caused collisions at
-            0.1 s, 149/200 with 32 at 0.2 s.
+            ``check_period_s`` always. On DynaBARN ``twist`` 0.1 s reached 161/200 with 15
+            robot-caused collisions, 0.2 s 149/200 with 32 (``docs/perception.md``).
         **kwargs: Further options of :class:`SequentialBITStarAgent` (planning_delay, ...).
     """
 
@@ -153,7 +154,8 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
     def __init__(self, config: SequentialConfig | None = None, *, patience_s: float = 3.0,
                  max_wait_s: float = 30.0, lattice_dt_s: float = 0.25, accept_s: float = 0.5,
                  horizon_s: float | None = 3.0, plan_extra_m: float | None = 0.3,
-                 guard: str = "growth", manoeuvre_accel: float = 0.0,
+                 guard: str = "growth", outrun_margin_mps: float | None = 1.0 / 3.0,
+                 manoeuvre_accel: float = 0.0,
                  announced_horizon_s: float | None = 30.0,
                  passive_safety: bool = False, reach_extra_mps: float = 0.3,
                  reach_min_speed_mps: float = 0.0, search_budget_s: float | None = 0.02,
@@ -180,6 +182,10 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         if guard not in ("growth", "horizon", "never"):
             raise ValueError(f"guard: 'growth', 'horizon' or 'never', got {guard!r}")
         self.guard_mode = guard
+        if outrun_margin_mps is not None and not (isinstance(outrun_margin_mps, int | float)
+                                                  and outrun_margin_mps >= 0.0):
+            raise ValueError(f"outrun_margin_mps: must be >= 0 or null, got {outrun_margin_mps!r}")
+        self.outrun_margin_mps = None if outrun_margin_mps is None else float(outrun_margin_mps)
         if not (isinstance(manoeuvre_accel, int | float) and manoeuvre_accel >= 0.0):
             raise ValueError(f"manoeuvre_accel: must be >= 0, got {manoeuvre_accel!r}")
         self.manoeuvre_accel = float(manoeuvre_accel)

@@ -4,8 +4,9 @@ Certain predictions (announced motions; exact twists with ``guard="growth"``) ar
 against in full, announced motions up to ``announced_horizon_s`` ahead. Uncertain ones
 (tracked: discs that grow with the horizon) are planned and timed against discs whose extra
 radius is capped at ``plan_extra_m``, on a receding horizon, while the safety guard checks the
-full growth (``docs/perception.md``, "st-bitstar when the future is unknown"). When one
-planned disc holds every place the robot can reach, no search is made (``_trapped``).
+full growth of the obstacles the robot does not outrun (``_outruns``; ``docs/perception.md``,
+"st-bitstar when the future is unknown"). When one planned disc holds every place the robot
+can reach, no search is made (``_trapped``).
 :class:`PlanningPredictions` is the agent's part that makes these views.
 """
 
@@ -32,16 +33,18 @@ _TRAP_HORIZON_S = 10.0
 class PlanningPredictions:
     """The views of the predictions an ``st-bitstar`` agent plans with (a mixin: it reads the
     agent's ``spec``, ``config.margin``, ``guard_mode``, ``plan_extra_m``,
-    ``announced_horizon_s`` and ``record``)."""
+    ``outrun_margin_mps``, ``announced_horizon_s`` and ``record``)."""
 
     spec: Any
     config: Any
     record: Any
     guard_mode: str
     plan_extra_m: float | None
+    outrun_margin_mps: float | None
     announced_horizon_s: float | None
-    #: :meth:`_capped`'s last answer: (cap [m], its predictions, the capped ones).
-    _capped_memo: tuple[float, tuple[PredictedObstacle, ...], list[PredictedObstacle]] | None = None
+    #: :meth:`_capped`'s answers for the latest predictions: (cap [m], {id of a prediction:
+    #: (it, its capped disc)}).
+    _capped_memo: tuple[float, dict[int, tuple[PredictedObstacle, PredictedObstacle]]] | None = None
 
     def _planning_preds(self, preds: list[PredictedObstacle], p: np.ndarray,
                         t: float) -> list[PredictedObstacle]:
@@ -79,8 +82,9 @@ class PlanningPredictions:
 
     def _split(self, preds: list[PredictedObstacle], p: np.ndarray, t: float
                ) -> tuple[list[PredictedObstacle], list[PredictedObstacle] | None]:
-        """The predictions planned and timed against from ``p`` at ``t`` [s], and the full
-        ones the safety guard checks (None when every prediction is certain: no guard)."""
+        """The predictions planned and timed against from ``p`` at ``t`` [s], and those the
+        safety guard checks (None when every prediction is certain: no guard): the full discs,
+        but the planned (capped) one of an obstacle the robot outruns (:meth:`_outruns`)."""
         announced = bool(preds) and all(o.until == math.inf for o in preds)
         preds = self._certain(preds)
         if announced:
@@ -88,7 +92,20 @@ class PlanningPredictions:
         safe = self._planning_preds(preds, p, t)
         if safe is preds:
             return preds, None
-        return self._capped(safe), safe
+        planned = self._capped(safe)
+        if self.outrun_margin_mps is not None:
+            safe = [c if self._outruns(o) else o for o, c in zip(safe, planned, strict=True)]
+        return planned, safe
+
+    def _outruns(self, o: PredictedObstacle) -> bool:
+        """Whether the robot outruns the uncertain prediction ``o``: its top speed exceeds the
+        obstacle's predicted speed by more than ``outrun_margin_mps`` (None: never). Fleeing,
+        the robot then leaves the disc's growth behind within the horizon (the default, 1/3
+        m/s, gains the 1 m growth cap in the 3 s horizon), so a late reaction to a turn, at its
+        next check, is in time: the guard checks the disc planned against, not the full one."""
+        m = self.outrun_margin_mps
+        return (m is not None and o.growth is not None
+                and o.max_speed < self.spec.v_max - m)
 
     def _announced(self, preds: list[PredictedObstacle], t: float) -> list[PredictedObstacle]:
         """Announced motions on the receding horizon ``announced_horizon_s`` from ``t`` [s]:
@@ -110,11 +127,13 @@ class PlanningPredictions:
         return [dataclasses.replace(o, until=math.inf) for o in preds]
 
     def _guarded_by(self, safe: list[PredictedObstacle]) -> bool:
-        """Whether the safety guard decides what starts: predictions with uncertain discs
-        (``guard="growth"``, tracked perception), any with a horizon (``"horizon"``), or never."""
+        """Whether the safety guard decides what starts: predictions with uncertain discs of
+        obstacles the robot does not outrun (``guard="growth"``, tracked perception), any with
+        a horizon (``"horizon"``), or never."""
         if self.guard_mode == "horizon":
             return True
-        return self.guard_mode == "growth" and any(o.growth is not None for o in safe)
+        return self.guard_mode == "growth" and any(
+            o.growth is not None and not self._outruns(o) for o in safe)
 
     def _capped(self, preds: list[PredictedObstacle]) -> list[PredictedObstacle]:
         """``preds`` with their extra radius capped at ``plan_extra_m`` (what paths are planned
@@ -122,18 +141,27 @@ class PlanningPredictions:
         c = self.plan_extra_m
         if c is None:
             return preds
-        # The last answer is kept: the safety guard caps the predictions the planning capped
-        # (the same objects, so the contact searches' caches of prediction sets serve both;
-        # the entry holds them, so an ``id`` seen here is the same live object).
-        memo = self._capped_memo
-        if memo is not None and memo[0] == c and len(memo[1]) == len(preds) and all(
-                a is b for a, b in zip(memo[1], preds, strict=True)):
-            return list(memo[2])
-        out = [o if o.growth is None or o.growth.max_extra <= c else
-               PredictedObstacle(o.name, o.radius, o.motion, o.growth.capped(c), o.until)
-               for o in preds]
-        self._capped_memo = (c, tuple(preds), out)
-        return list(out)
+        # Each prediction's capped disc is kept while its predictions are in use: the safety
+        # guard caps the predictions the planning capped, some of them capped already
+        # (:meth:`_split`), and gets the same objects, so the contact searches' caches of
+        # prediction sets serve both (the entry holds the prediction, so its ``id`` is live).
+        seen = self._capped_memo[1] if self._capped_memo and self._capped_memo[0] == c else {}
+        out, fresh, hits = [], {}, 0
+        for o in preds:
+            if o.growth is None or o.growth.max_extra <= c:
+                out.append(o)
+                continue
+            old = seen.get(id(o))
+            if old is not None and old[0] is o:
+                hits += 1
+                capped = old[1]
+            else:
+                capped = PredictedObstacle(o.name, o.radius, o.motion, o.growth.capped(c), o.until)
+            fresh[id(o)] = (o, capped)
+            out.append(capped)
+        # new predictions (no hit) replace the kept ones; the same ones add to them
+        self._capped_memo = (c, {**seen, **fresh} if hits or not fresh else fresh)
+        return out
 
     def _trapped(self, preds: list[PredictedObstacle], state: RobotState, t: float) -> bool:
         """Whether a planned disc holds every place the robot can reach from ``state`` at
