@@ -10,8 +10,8 @@ wins. Every motion is verified (:func:`anyplan.trajectory.spacetime.verify`) bef
 executed; when none is, the robot brakes to rest and holds (``extra.fallbacks``). The online
 timing policy is :class:`~anyplan.agents.replanning.ReplanningAgent`'s, shared with
 ``seq-bitstar``. With uncertain (tracked) predictions it plans on a receding horizon against
-capped discs, and the safety guard checks each motion against the full discs
-(``docs/perception.md``, "st-bitstar when the future is unknown"). Statistics:
+capped discs, and the safety guard checks each motion against the full discs of the obstacles
+it does not outrun (``docs/perception.md``, "st-bitstar when the future is unknown"). Statistics:
 :class:`~anyplan.agents.stats.SpaceTimeStats`. See ``docs/spacetime.md``.
 """
 
@@ -103,7 +103,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             the whole motions (the paper's assumption).
         plan_extra_m: With such predictions, paths are planned and timed against discs whose
             extra radius is capped at this [m]; the safety guard checks every motion against
-            the full growth (free to rest, or stoppable) before it starts. None: no cap.
+            the full growth of the obstacles not outrun before it starts. None: no cap.
         guard: ``"growth"``: the horizon and the guard apply to uncertain discs (``tracked``),
             exact twists (``twist``) are planned against in full; ``"horizon"``: both apply to
             every prediction without an announced motion; ``"never"``: the horizon alone.

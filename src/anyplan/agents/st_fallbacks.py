@@ -2,9 +2,10 @@
 and the fallbacks (``docs/perception.md``, "st-bitstar when the future is unknown").
 
 :class:`SafetyDecisions` is the agent's part that decides: the safety invariant (free to rest,
-or stoppable) against the full uncertain discs, a stoppable motion giving way to a freer
-evasion, and the best fallback of :func:`~anyplan.agents.evasion.best_fallback` when nothing
-planned may start. The candidates and their ranking are :mod:`anyplan.agents.evasion`'s.
+or stoppable) against the full uncertain discs of the obstacles the robot does not outrun, a
+stoppable motion giving way to a freer evasion, and the best fallback of
+:func:`~anyplan.agents.evasion.best_fallback` when nothing planned may start. The candidates
+and their ranking are :mod:`anyplan.agents.evasion`'s.
 """
 
 from __future__ import annotations
@@ -49,7 +50,8 @@ class SafetyDecisions:
     def _guard(self, obs: Observation, t_switch: float, motion: Trajectory | None,
                safe: list[PredictedObstacle], observed: list[PredictedObstacle],
                reason: str) -> tuple[str, Trajectory | None]:
-        """The safety invariant against the full uncertain predictions ``safe``: start
+        """The safety invariant against the predictions ``safe`` (the full uncertain discs of
+        the obstacles the robot does not outrun, :meth:`PlanningPredictions._split`): start
         ``motion`` at ``t_switch`` [s] if it is free to rest or stoppable there, else keep the
         current motion if it still is, else the best of :meth:`_evasions`; a stoppable one
         gives way to an evasion that is free where it is not (``freer_evasion``). With
