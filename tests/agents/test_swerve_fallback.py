@@ -1,5 +1,6 @@
 """st-bitstar's swerves: fallbacks that leave an obstacle's way without stopping first, offered
-only against certain predictions (exact twists, announced motions)."""
+only against certain predictions (exact twists, announced motions), or uncertain ones of
+obstacles the robot all outruns."""
 
 from __future__ import annotations
 
@@ -70,3 +71,25 @@ def test_a_swerve_wins_only_on_a_better_head():
 def test_the_swerves_setting_is_checked():
     with pytest.raises(ValueError, match="swerves"):
         make_agent("st-bitstar", swerves="yes")
+
+
+def test_swerves_among_uncertain_discs_when_the_robot_outruns_every_obstacle(monkeypatch):
+    # When the robot outruns every uncertain obstacle, st-bitstar's guard does not decide, and
+    # its fallback offers the swerves as among certain predictions; a walker it does not
+    # outrun (1 m/s against the robot's 1 m/s) keeps them out.
+    from anyplan.agents.base import Observation
+
+    agent = _agent_in_empty_room(**LIMITS)
+    state = RobotState(5.0, 1.5, math.pi / 2, 1.0, 0.0)
+    growth = RadiusGrowth(0.0, np.array([0.0, 2.0]), np.array([0.0, 0.4]))
+    grown = _walker(growth)
+    assert "swerve" in {k for k, _ in agent._ranker(outrun=True).candidates(0.0, state, grown)}
+    slow = [PredictedObstacle("S", 0.25, UnicycleMotion(5.0, 4.0, -math.pi / 2, 0.5), growth,
+                              until=5.0)]  # 0.5 m/s < 1 m/s - 1/3 m/s: outrun
+    seen: list[bool] = []
+    ranker = agent._ranker
+    monkeypatch.setattr(agent, "_ranker", lambda outrun=False: seen.append(outrun) or ranker(outrun))
+    obs = Observation(0.0, state)
+    agent._fallback(obs, 0.0, slow, "test")
+    agent._fallback(obs, 0.0, grown, "test")
+    assert seen == [True, False]

@@ -125,12 +125,16 @@ class FallbackRanker:
         commit_s: Time [s] a fallback is followed before the robot can act again (the escape
             of the passive-safety check).
         swerves: Offer the :data:`SWERVES` too (arcs entered at the robot's speed, then a
-            brake) when no prediction is uncertain (exact twists, announced motions).
+            brake) when no prediction is uncertain (exact twists, announced motions), or when
+            ``outrun``.
+        outrun: The robot outruns every uncertain obstacle of the predictions ranked against
+            (``st-bitstar``'s guard does not decide): swerves as among certain predictions.
     """
 
     def __init__(self, spec: RobotSpec, obstacles: ObstacleSet, guard: SafetyGuard,
-                 commit_s: float, swerves: bool = False) -> None:
+                 commit_s: float, swerves: bool = False, outrun: bool = False) -> None:
         self.swerves = bool(swerves)
+        self.outrun = bool(outrun)
         self.spec = spec
         self.obstacles = obstacles
         self.guard = guard
@@ -237,8 +241,9 @@ class FallbackRanker:
         clearance the robot has when it is closer to a wall) along a straight line from rest and,
         when the robot moves, along a smooth curve from its speed and heading (obstacles that
         ignore the robot are escaped by moving, not only by stopping), with :attr:`swerves` and
-        no uncertain prediction in ``safe`` the :data:`SWERVES` (arcs entered at the robot's
-        speed and turn rate within a_max and alpha_max, held :data:`SWERVE_S`, then a brake:
+        no uncertain prediction in ``safe`` (or :attr:`outrun`) the :data:`SWERVES` (arcs
+        entered at the robot's speed and turn rate within a_max and alpha_max, held
+        :data:`SWERVE_S`, then a brake:
         :func:`~anyplan.trajectory.motion.swerve_trajectory`; a differential-drive robot that
         turns in place first stands in the obstacle's way), and, last, keeping ``current``
         (e.g. the curve that clears a wall when braking straight would not)."""
@@ -270,7 +275,7 @@ class FallbackRanker:
                                  allow_turn=False)
                 if tr.certified_free and tr.feasible:
                     cands.append(("evade", tr))
-        if self.swerves and all(getattr(o, "growth", None) is None for o in safe):
+        if self.swerves and (self.outrun or all(getattr(o, "growth", None) is None for o in safe)):
             for v1, w1 in SWERVES:
                 tr = swerve_trajectory(state, spec, obstacles, radius, t, v1 * spec.v_max,
                                        w1 * spec.omega_max, SWERVE_S)

@@ -128,7 +128,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             twists, announced motions): a differential-drive robot that turns in place first
             stands in the obstacle's way. Measured (``docs/perception.md``, "Fallbacks"): on
             DynaBARN ``twist`` 339/400 reached against 323/400 without; among uncertain discs
-            they added robot-caused collisions and are not offered.
+            only when the robot outruns them all.
         twist_check_period_s: How often [s] the motion in use is checked while the obstacles
             in view are predicted from their exact current twists (``twist`` perception: no
             announced motion, no uncertain disc). Each check is the robot's next chance to

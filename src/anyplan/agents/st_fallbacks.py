@@ -44,6 +44,7 @@ class SafetyDecisions:
     reach_min_speed_mps: float
     swerves: bool
     _capped: Callable[[list[PredictedObstacle]], list[PredictedObstacle]]  # PlanningPredictions'
+    _outruns: Callable[[PredictedObstacle], bool]  # PlanningPredictions'
     _state_at: Callable[[Observation, float], RobotState]  # ReplanningAgent's
     _period: Callable[[], float]  # the check period in force [s] (SpaceTimeBITStarAgent's)
 
@@ -108,16 +109,18 @@ class SafetyDecisions:
         <anyplan.agents.evasion.FallbackRanker.rank>`) and its clearance [m]."""
         return self._ranker().rank(tr, t, full, planned, reach)
 
-    def _ranker(self) -> FallbackRanker:
-        return FallbackRanker(self.spec, self.obstacles, self.guard, self._period(), self.swerves)
+    def _ranker(self, outrun: bool = False) -> FallbackRanker:
+        return FallbackRanker(self.spec, self.obstacles, self.guard, self._period(), self.swerves,
+                              outrun)
 
     def _fallback(self, obs: Observation, t_switch: float, preds: list[PredictedObstacle],
                   reason: str) -> Trajectory | None:
-        """No motion was found and the one in use is no longer free (certain predictions, no
-        guard): the best fallback of :meth:`_evasions` (brake or hold, turn away, back off,
-        evade, or keep the motion in use when strictly better), ranked by predicted clearance,
-        never a blind brake. Before, braking on the current reference was the only fallback:
-        in DynaBARN world 58 (``twist``) the robot braked straight into the path of an
+        """No motion was found and the one in use is no longer free, and no guard decides
+        (certain predictions, or uncertain ones of obstacles the robot all outruns): the best
+        fallback (brake or hold, turn away, back off, evade, swerve, or keep the motion in use
+        when strictly better; :func:`~anyplan.agents.evasion.best_fallback`), ranked by
+        predicted clearance, never a blind brake. Before, braking on the current reference was
+        the only fallback: in DynaBARN world 58 (``twist``) the robot braked straight into the path of an
         obstacle that had just turned, its collision predicted 0.9 s ahead, while turning away
         was free. Returns None to keep the motion in use."""
         state = self._state_at(obs, t_switch)
@@ -126,7 +129,11 @@ class SafetyDecisions:
                                         stop_rotation=False)
             kind, clear = "brake-hold", math.inf
         else:
-            kind, tr, clear = self._evasions(t_switch, state, preds, None, self.trajectory)
+            # the guard did not decide: with uncertain discs, the robot outruns every obstacle
+            # (PlanningPredictions._outruns), and swerves are offered as among certain ones
+            outrun = all(o.growth is None or self._outruns(o) for o in preds)
+            kind, tr, clear = best_fallback(self._ranker(outrun), t_switch, state, preds,
+                                            self._capped(preds), None, self.trajectory)
         if kind == "keep":
             return None
         self.record.fallbacks.append(
