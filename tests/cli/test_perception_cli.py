@@ -60,6 +60,9 @@ def test_run_records_the_tracker_settings_it_used(tmp_path):
     # the given ones, the sensor's noise as the tracker's, the defaults elsewhere
     assert t["q_cv"] == 0.01 and t["k_sigma"] == 1.5 and t["sigma_m"] == 0.2
     assert t["q_ct"] == 0.05 and t["cap_m"] == 1.0
+    # and the settings given, as anyplan bench records them
+    given = json.loads((out / "result.json").read_text())["extra"]["settings"]
+    assert given == "tracker.k_sigma = 1.5;tracker.q_cv = 0.01;"
 
 
 @pytest.mark.parametrize("perception", [[], ["--perception", "twist"]])

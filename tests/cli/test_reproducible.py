@@ -42,6 +42,10 @@ def test_the_same_deterministic_command_twice_gives_the_same_result(tmp_path):
     c = _run(tmp_path, "c", "--set", "planning_delay=0.1", "--set", "batches_per_plan=2",
              "--set", "max_time_s=10")
     assert without_wall_clock(c) == ra
+    # the settings given are recorded, as anyplan bench records them
+    assert a["extra"]["settings"] == c["extra"]["settings"]
+    assert all(f"{k} = " in a["extra"]["settings"]
+               for k in ("planning_delay", "batches_per_plan", "max_time_s"))
 
 
 def test_values_are_yaml_scalars_checked_against_the_settings():

@@ -18,6 +18,7 @@ from anyplan.cli.perception_opts import (
     tracker_settings,
 )
 from anyplan.errors import UsageError
+from anyplan.experiments.db import agent_settings_string
 from anyplan.simulation.simulator import SimConfig, simulate
 from anyplan.world.scenario import builtin_scenarios, load_scenario
 
@@ -144,6 +145,9 @@ def _run(args: argparse.Namespace) -> int:
         checks.writable_file(args.mcap, "run: --mcap", (".mcap",), make_parent=False)
     agent = make_agent(args.planner, **config)
     result = simulate(scenario, agent, seed=args.seed, config=cfg)
+    # the settings given (--set, --deterministic, --tracker), as anyplan bench records them: with
+    # the seed and the scenario, what reproduces the run
+    result.extra["settings"] = agent_settings_string(config, cfg.tracker)
     (out / "result.json").write_text(json.dumps(result.to_dict(), indent=1))
     if not args.no_plot:
         from anyplan.viz.run import save_run_figure
