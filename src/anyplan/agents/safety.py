@@ -336,11 +336,7 @@ class SafetyGuard:
                 and np.array_equal(memo[1], ts) and all(
                     a is b for a, b in zip(memo[0], preds, strict=True)):
             return memo[2]
-        q = np.stack([np.asarray(o.positions(ts), dtype=float) for o in preds])
-        ro = np.array([_max_radius(o) for o in preds])
-        vo = np.array([float(o.max_speed) for o in preds])
-        until = np.array([float(getattr(o, "until", math.inf)) for o in preds])
-        out = (q, ro, vo, until)
+        out = _tracks(preds, ts)
         self._tracks_memo = (tuple(preds), ts.copy(), out)
         return out
 
@@ -433,11 +429,9 @@ def _threat(preds: Sequence[PredictedObstacle], ts: np.ndarray, pr: np.ndarray,
     u: np.ndarray | None = None
     # every obstacle at once, element by element the operations of a search one obstacle at
     # a time that keeps the first strictly nearer one
-    q = np.stack([np.asarray(o.positions(ts), dtype=float) for o in preds])
-    d = np.hypot(pr[None, :, 0] - q[:, :, 0], pr[None, :, 1] - q[:, :, 1]) \
-        - np.array([_max_radius(o) for o in preds])[:, None]
-    d[ts[None, :] > np.array([float(getattr(o, "until", math.inf)) for o in preds])[:, None]] \
-        = math.inf
+    q, ro, _, until = _tracks(preds, ts)
+    d = np.hypot(pr[None, :, 0] - q[:, :, 0], pr[None, :, 1] - q[:, :, 1]) - ro[:, None]
+    d[ts[None, :] > until[:, None]] = math.inf
     k = np.argmin(d, axis=1)
     dk = d[np.arange(len(preds)), k]
     if np.isnan(dk).any():  # NaN never wins the comparison one at a time: as there
@@ -453,6 +447,16 @@ def _threat(preds: Sequence[PredictedObstacle], ts: np.ndarray, pr: np.ndarray,
 
 #: Predictions on a time grid: centres (n, T, 2), largest radii, speed bounds, horizons.
 _Tracks = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def _tracks(preds: Sequence[PredictedObstacle], ts: np.ndarray) -> _Tracks:
+    """Every prediction's centres (n, len(ts), 2) [m] at ``ts`` [s], largest radii [m], speed
+    bounds [m/s] and horizons [s]."""
+    q = np.stack([np.asarray(o.positions(ts), dtype=float) for o in preds])
+    ro = np.array([_max_radius(o) for o in preds])
+    vo = np.array([float(o.max_speed) for o in preds])
+    until = np.array([float(getattr(o, "until", math.inf)) for o in preds])
+    return q, ro, vo, until
 
 
 def _max_radius(o: Any) -> float:

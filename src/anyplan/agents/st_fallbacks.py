@@ -95,11 +95,13 @@ class SafetyDecisions:
 
     def _evasions(self, t: float, state: RobotState, safe: list[PredictedObstacle],
                   motion: Trajectory | None, current: Trajectory | None = None,
-                  reach: Sequence[PredictedObstacle] = ()) -> tuple[str, Any, float]:
+                  reach: Sequence[PredictedObstacle] = (), outrun: bool = False
+                  ) -> tuple[str, Any, float]:
         """The best fallback from ``state`` at ``t`` [s], with its clearance [m]:
         :func:`anyplan.agents.evasion.best_fallback` against the full predictions ``safe``
-        and the capped ones planned against, ``reach`` with ``passive_safety``."""
-        return best_fallback(self._ranker(), t, state, safe, self._capped(safe), motion,
+        and the capped ones planned against, ``reach`` with ``passive_safety``; ``outrun``:
+        the robot outruns every uncertain obstacle (swerves offered, :class:`FallbackRanker`)."""
+        return best_fallback(self._ranker(outrun), t, state, safe, self._capped(safe), motion,
                              current, reach)
 
     def _fallback_rank(self, tr: Any, t: float, full: list[PredictedObstacle],
@@ -132,8 +134,8 @@ class SafetyDecisions:
             # the guard did not decide: with uncertain discs, the robot outruns every obstacle
             # (PlanningPredictions._outruns), and swerves are offered as among certain ones
             outrun = all(o.growth is None or self._outruns(o) for o in preds)
-            kind, tr, clear = best_fallback(self._ranker(outrun), t_switch, state, preds,
-                                            self._capped(preds), None, self.trajectory)
+            kind, tr, clear = self._evasions(t_switch, state, preds, None, self.trajectory,
+                                             outrun=outrun)
         if kind == "keep":
             return None
         self.record.fallbacks.append(
