@@ -89,7 +89,9 @@ def _run(task: tuple[str, dict[str, Any], str, str, int, dict[str, Any],
             "collision_with": res.collision_with, "collision_time_s": res.collision_time_s,
             "appeared_in_contact": appeared, "appeared_within_stop": appeared_late,
             "min_dist": res.min_distance_to_moving_m, "discomfort": res.discomfort_time_s,
-            "t_over_lb": res.time_over_lower_bound, "times": list(res.planning_times_s)}
+            "t_over_lb": res.time_over_lower_bound, "tracking_max_m": res.extra.get("tracking_max_m"),
+            "reanchored": len(res.extra.get("reanchored_s") or ()),
+            "times": list(res.planning_times_s)}
 
 
 def _dynabarn(worlds: list[int]) -> list[dict[str, Any]]:

@@ -6,7 +6,8 @@ decide *what* to plan (:meth:`ReplanningAgent._replan`) and when the current mot
 from the state the robot will have at ``t + d`` on its current reference, d being the expected
 planning delay rounded up to the control period (``planning_delay``: ``"measured"`` or fixed
 seconds); a computation that outlasts d switches later (a *late plan*). The motion in use is
-re-checked every ``check_period_s`` and tracked with Kanayama's law. The bookkeeping of one
+re-checked every ``check_period_s`` and tracked with Kanayama's law; a robot found farther than
+``reanchor_m`` from its reference plans from its own state instead. The bookkeeping of one
 replanning (statuses, reasons, counts) lives in :meth:`ReplanningAgent._record_replan`, into a
 :class:`~anyplan.agents.stats.SequentialStats` record. See ``docs/sequential.md`` ("Online
 execution").
@@ -22,14 +23,18 @@ from typing import Any
 from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
 from anyplan.agents.stats import SequentialStats
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
+from anyplan.geometry.se2 import unicycle_arc, wrap_angle
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import Command, RobotSpec, RobotState
 
-__all__ = ["ReplanningAgent", "MAX_BACKOFF_S"]
+__all__ = ["ReplanningAgent", "MAX_BACKOFF_S", "REANCHOR_RAD"]
 
 #: Longest wait [s] between two replannings after repeated failures.
 MAX_BACKOFF_S = 2.0
+
+#: Heading error [rad] beyond which the robot is off its reference (``reanchor_m``).
+REANCHOR_RAD = 0.3
 
 
 class ReplanningAgent(Agent):
@@ -44,6 +49,10 @@ class ReplanningAgent(Agent):
             delay [s] by which each new motion starts after the replanning decision.
         max_delay_s: Cap [s] on the measured delay.
         gains: Kanayama gains.
+        reanchor_m: Tracking error [m] beyond which the robot is *off its reference* (also when
+            its heading is more than :data:`REANCHOR_RAD` off): the next motion then starts
+            from the robot's own state, its twist held until the switch, instead of the
+            reference's, and a replanning is asked for. None: always from the reference.
     """
 
     record: SequentialStats
@@ -52,7 +61,8 @@ class ReplanningAgent(Agent):
 
     def __init__(self, *, check_period_s: float = 0.2, min_replan_interval_s: float = 0.5,
                  urgent_s: float = 3.0, planning_delay: str | float = "measured",
-                 max_delay_s: float = 0.5, gains: KanayamaGains | None = None) -> None:
+                 max_delay_s: float = 0.5, gains: KanayamaGains | None = None,
+                 reanchor_m: float | None = 0.2) -> None:
         super().__init__()
         if not check_period_s > 0.0:
             raise ValueError(f"check_period_s: must be > 0, got {check_period_s}")
@@ -65,6 +75,9 @@ class ReplanningAgent(Agent):
         self.planning_delay = planning_delay
         self.max_delay_s = float(max_delay_s)
         self.gains = gains or KanayamaGains()
+        if reanchor_m is not None and not (isinstance(reanchor_m, int | float) and reanchor_m > 0.0):
+            raise ValueError(f"reanchor_m: must be > 0 or null, got {reanchor_m!r}")
+        self.reanchor_m = None if reanchor_m is None else float(reanchor_m)
 
     # --- lifecycle -------------------------------------------------------------------------------
     def _reset_timing(self, record: SequentialStats) -> None:
@@ -82,6 +95,7 @@ class ReplanningAgent(Agent):
         self._retry_at = -math.inf  # no replanning before this time [s] (back-off)
         self._seen: set[str] = set()
         self._requested: str | None = None
+        self._off_reference = False  # the robot is off its reference at this step (reanchor_m)
         self.tracking = TrackingLog()
         self.executed: list[tuple[float, Trajectory]] = []  # (switch time [s], trajectory)
         self._call_start = 0.0  # wall clock [s] at the start of the replanning call
@@ -100,11 +114,30 @@ class ReplanningAgent(Agent):
         return max(dt, math.ceil(d / dt - 1e-9) * dt)
 
     def _state_at(self, obs: Observation, t: float) -> RobotState:
-        """The state the robot will have at time ``t`` [s]: on its reference, or at rest."""
+        """The state the robot will have at time ``t`` [s]: on its reference, or at rest; off
+        its reference (``reanchor_m``), its own pose moved on with its twist held."""
+        r = obs.robot
         if self.trajectory is None:
-            r = obs.robot
             return RobotState(r.x, r.y, r.theta, 0.0, 0.0)
+        if self._off_reference:
+            x, y, th = unicycle_arc(r.x, r.y, r.theta, r.v, r.omega, max(t - obs.t, 0.0))
+            return RobotState(x, y, float(wrap_angle(th)), r.v, r.omega)
         return self.trajectory.state(t)
+
+    def _note_tracking(self, obs: Observation, traj: Trajectory) -> None:
+        """Log this step's tracking error and note whether the robot is off its reference
+        (``reanchor_m``); if it is, ask for a replanning (from the robot's own state)."""
+        ref = traj.state(obs.t)
+        r = obs.robot
+        self.tracking.add((ref.x, ref.y), r, self.record)
+        off = self.reanchor_m is not None and (
+            math.hypot(ref.x - r.x, ref.y - r.y) > self.reanchor_m
+            or abs(float(wrap_angle(r.theta - ref.theta))) > REANCHOR_RAD)
+        if off and not self._off_reference and self.pending is None and self._requested is None:
+            self.record.reanchored_s.append(float(obs.t))
+            self.request_replan(f"off the reference by {math.hypot(ref.x - r.x, ref.y - r.y):.2f} m: "
+                                "the next motion starts from the robot's own state")
+        self._off_reference = off
 
     def _begin_replan(self, obs: Observation) -> tuple[float, float, float, RobotState]:
         """``(dt, d, t_ready, state)``: the control period, the expected delay, the time the new
@@ -218,6 +251,9 @@ class ReplanningAgent(Agent):
         self._note_predictions(preds)
         if self.pending is not None and t >= self.pending[0] - 1e-9:
             self._switch()
+        noted = self.trajectory is not None
+        if noted:
+            self._note_tracking(obs, self.trajectory)  # type: ignore[arg-type]
         if self.trajectory is None and self.pending is None:
             # The first plan: the robot stays at rest while it is computed.
             if t < self._retry_at - 1e-9:
@@ -234,8 +270,8 @@ class ReplanningAgent(Agent):
         traj = self.trajectory
         if traj is None:
             return Command(0.0, 0.0)
-        ref = traj.state(t)
-        self.tracking.add((ref.x, ref.y), obs.robot, self.record)
+        if not noted:
+            self._note_tracking(obs, traj)
         return self.controller.command(traj, obs.robot, t)
 
     def request_replan(self, reason: str) -> None:

@@ -52,6 +52,8 @@ class SequentialBITStarAgent(ReplanningAgent):
         gains: Kanayama gains.
         safety: Apply the safety invariant (:mod:`anyplan.agents.safety`).
         safety_config: Its settings (default: margin = the loop's ``margin``).
+        reanchor_m: Tracking error [m] beyond which the next motion starts from the robot's
+            own state (:class:`~anyplan.agents.replanning.ReplanningAgent`); None: never.
     """
 
     name = "seq-bitstar"
@@ -69,7 +71,8 @@ class SequentialBITStarAgent(ReplanningAgent):
                  min_replan_interval_s: float = 0.5, urgent_s: float = 3.0,
                  planning_delay: str | float = "measured", grid_step: float = 0.05,
                  gains: KanayamaGains | None = None, safety: bool = True,
-                 safety_config: SafetyConfig | None = None, **loop_options: Any) -> None:
+                 safety_config: SafetyConfig | None = None, reanchor_m: float | None = 0.2,
+                 **loop_options: Any) -> None:
         if config is None:
             config = SequentialConfig(**loop_options)
         elif loop_options:
@@ -79,7 +82,7 @@ class SequentialBITStarAgent(ReplanningAgent):
         super().__init__(check_period_s=check_period_s,
                          min_replan_interval_s=min_replan_interval_s, urgent_s=urgent_s,
                          planning_delay=planning_delay, max_delay_s=config.max_time_s,
-                         gains=gains)
+                         gains=gains, reanchor_m=reanchor_m)
         self.config = config
         self.plan_margin = float(plan_margin)
         self.smooth_margin = float(smooth_margin)

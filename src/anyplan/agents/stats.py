@@ -107,14 +107,17 @@ class SequentialStats(StatsRecord):
             before the first motion starts).
         tracking_rms_m: RMS distance [m] between robot and reference.
         tracking_max_m: Largest such distance [m].
+        reanchored_s: Simulated times [s] at which the robot was found off its reference
+            (``reanchor_m``) and a replanning from its own state was asked for (left out
+            when empty).
     """
 
     KEYS: ClassVar[tuple[str, ...]] = (
         "statuses", "iterations", "late_plans", "plan_time_s", "motion_time_s", "replan_times_s",
         "waits", "fallbacks", "safety_time_s", "reasons", "progress", "safety", "tracking",
-        *_TRACKING)
+        *_TRACKING, "reanchored_s")
     OPTIONAL: ClassVar[frozenset[str]] = frozenset({"reasons", "progress", "safety", "tracking",
-                                                    *_TRACKING})
+                                                    *_TRACKING, "reanchored_s"})
     WALL_CLOCK: ClassVar[tuple[str, ...]] = ("plan_time_s", "motion_time_s", "progress",
                                              "late_plans", "safety_time_s")
 
@@ -132,6 +135,7 @@ class SequentialStats(StatsRecord):
     safety: list[dict[str, Any]] | None = None
     tracking_rms_m: float | None = None
     tracking_max_m: float | None = None
+    reanchored_s: list[float] = field(default_factory=list)
 
 
 @dataclass
@@ -154,7 +158,8 @@ class SpaceTimeStats(SequentialStats):
     KEYS: ClassVar[tuple[str, ...]] = (
         "statuses", "iterations", "late_plans", "plan_time_s", "motion_time_s", "replan_times_s",
         "waits", "fallbacks", "safety_time_s", "st_waits_s", "st_timed", "st_candidates",
-        "st_pruned", "st_trapped", "inside_discs", "reasons", "progress", "safety", "tracking", *_TRACKING)
+        "st_pruned", "st_trapped", "inside_discs", "reasons", "progress", "safety", "tracking", *_TRACKING,
+        "reanchored_s")
     OPTIONAL: ClassVar[frozenset[str]] = SequentialStats.OPTIONAL | {"inside_discs"}
 
     st_waits_s: list[float] = field(default_factory=list)
