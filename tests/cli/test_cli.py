@@ -44,6 +44,9 @@ def test_scenarios_lists_builtins(capsys):
     (["run", "missing.yaml"], "missing.yaml: no such file"),
     (["run", "paper-1", "--dt", "0.5"], "dt must be in"),
     (["run", "paper-1", "--seed", "x"], "invalid int value"),
+    (["run", "paper-1", "--actuation-noise", "0.1"], "expected SIGMA_V,SIGMA_OMEGA"),
+    (["run", "paper-1", "--actuation-noise", "0.1,-0.1"], "spreads must be in [0, 10], got -0.1"),
+    (["run", "paper-1", "--actuation-noise", "0.1,nan"], "finite"),
     (["frobnicate"], "invalid choice"),
 ])
 def test_bad_input_exits_2_with_one_line(argv, words, capsys, tmp_path, monkeypatch):

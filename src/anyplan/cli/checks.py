@@ -24,9 +24,10 @@ from anyplan.config import SettingError
 from anyplan.errors import AnyplanError, one_line, shorten
 from anyplan.world import limits as L
 
-__all__ = ["seed", "time_limit", "sim_step", "positive_seconds", "count", "playback_speed",
+__all__ = ["seed", "time_limit", "sim_step", "actuation_noise", "positive_seconds", "count", "playback_speed",
            "writable_file", "writable_folder", "safe_name", "PLOT_SUFFIXES", "MAX_RUNS", "MAX_TASKS",
-           "MAX_JOBS", "MAX_PLAN_TIME_S", "SPEED_RANGE", "SIM_FLAGS", "flag_message"]
+           "MAX_JOBS", "MAX_PLAN_TIME_S", "MAX_ACTUATION_SIGMA", "SPEED_RANGE", "SIM_FLAGS",
+           "flag_message"]
 
 #: :class:`~anyplan.simulation.SimConfig` fields and the flags of ``run`` and ``bench`` that set them.
 SIM_FLAGS = {"dt": "--dt", "time_limit": "--time-limit"}
@@ -94,6 +95,23 @@ def sim_step(text: str) -> float:
     if not L.MIN_DT_S <= x <= 0.05:
         raise argparse.ArgumentTypeError(f"dt must be in [{L.MIN_DT_S:g}, 0.05] s, got {x:g}")
     return x
+
+
+#: Largest execution-error spread accepted on the command line (m/s or rad/s).
+MAX_ACTUATION_SIGMA = 10.0
+
+
+def actuation_noise(text: str) -> tuple[float, float]:
+    """``SIGMA_V,SIGMA_OMEGA``: the robot's execution-error spreads [m/s, rad/s], each in
+    [0, MAX_ACTUATION_SIGMA]."""
+    parts = text.split(",")
+    if len(parts) != 2:
+        raise argparse.ArgumentTypeError(f"expected SIGMA_V,SIGMA_OMEGA (m/s, rad/s), got {shorten(text)}")
+    sv, sw = (_number(p.strip(), "a spread in m/s or rad/s") for p in parts)
+    for x in (sv, sw):
+        if not 0.0 <= x <= MAX_ACTUATION_SIGMA:
+            raise argparse.ArgumentTypeError(f"spreads must be in [0, {MAX_ACTUATION_SIGMA:g}], got {x:g}")
+    return sv, sw
 
 
 def positive_seconds(text: str) -> float:

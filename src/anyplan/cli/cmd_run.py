@@ -46,6 +46,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="simulation step [s], in [0.001, 0.05] (default 0.05)")
     p.add_argument("--time-limit", type=checks.time_limit, default=None,
                    help="simulated time limit [s] (default: the scenario's)")
+    p.add_argument("--actuation-noise", type=checks.actuation_noise, default=(0.0, 0.0),
+                   metavar="SV,SW", help="the robot drives its commands with a correlated error of "
+                   "these spreads [m/s, rad/s] (slip, lag; seeded by --seed; default 0,0: exactly)")
     p.add_argument("--no-plot", action="store_true", help="do not write run.png")
     p.add_argument("--format", default="png", choices=("png", "svg", "pdf"),
                    help="picture format: DIR/run.png, run.svg or run.pdf (default png)")
@@ -119,7 +122,9 @@ def _run(args: argparse.Namespace) -> int:
     config = run_config(args, args.planner)  # unknown names and bad settings fail before any work
     tracker = tracker_settings("run", args, [scenario])
     try:
-        cfg = SimConfig(dt=args.dt, time_limit=args.time_limit, tracker=tracker)
+        cfg = SimConfig(dt=args.dt, time_limit=args.time_limit, tracker=tracker,
+                        actuation_sigma_v=args.actuation_noise[0],
+                        actuation_sigma_omega=args.actuation_noise[1])
         cfg.steps(scenario.time_limit)
     except ValueError as exc:
         raise UsageError(f"run: {checks.flag_message(exc, checks.SIM_FLAGS)}") from None

@@ -27,6 +27,7 @@ from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.geometry.moving import closest_approach_straight
 from anyplan.planning.time_bound import scenario_time_lower_bound
 from anyplan.prediction.base import ObstacleObservation
+from anyplan.simulation.actuation import ActuationNoise
 from anyplan.simulation.contact import (
     approach_speed,
     disc_contact,
@@ -70,6 +71,10 @@ class SimConfig:
             (:mod:`anyplan.simulation.perception`).
         check_feasibility: Before the first step, end the run with status ``unreachable`` when
             the visibility graph proves the goal out of reach.
+        actuation_sigma_v, actuation_sigma_omega: The robot drives its achieved twist with a
+            correlated error of these stationary spreads [m/s, rad/s]
+            (:class:`~anyplan.simulation.actuation.ActuationNoise`; seeded by the run's seed,
+            recorded in ``result.extra["actuation"]``); 0 and 0: exactly.
         tracker: With ``tracked`` perception, settings of the robot's tracker and of its
             uncertain discs as ``(name, value)`` pairs (``anyplan run --tracker KEY=VALUE``;
             the names: :func:`~anyplan.simulation.perception.tracking_setting_names`); the
@@ -86,6 +91,10 @@ class SimConfig:
     announce_motions: bool = setting(True, doc="observations carry the obstacles' motion models")
     check_feasibility: bool = setting(True, doc="end at once when the goal is proven unreachable")
     tracker: tuple[tuple[str, float], ...] = ()
+    actuation_sigma_v: float = setting(0.0, lo=0.0, unit="m/s",
+                                       doc="spread of the robot's speed error (0: exact)")
+    actuation_sigma_omega: float = setting(0.0, lo=0.0, unit="rad/s",
+                                           doc="spread of the robot's turn-rate error (0: exact)")
 
     def __post_init__(self) -> None:
         validate(self)
@@ -121,7 +130,8 @@ class Simulation:
     Args:
         scenario: The full scenario (truth).
         config: Simulation settings.
-        seed: Seed of the sensor's noise (perception modes with noise).
+        seed: Seed of the sensor's noise (perception modes with noise) and of the robot's
+            execution error (``actuation_sigma_*``).
 
     Attributes:
         t: Simulation time [s] of the current state.
@@ -172,6 +182,8 @@ class Simulation:
             self._radii = np.zeros(0)
         self.last_hit: str | None = None
         self.sensor = Sensor(scenario, effective_sensing(scenario, cfg.announce_motions), seed)
+        self.actuation = (ActuationNoise(cfg.actuation_sigma_v, cfg.actuation_sigma_omega, seed)
+                          if cfg.actuation_sigma_v > 0.0 or cfg.actuation_sigma_omega > 0.0 else None)
         self.done = False
         self._check_goal()
 
@@ -220,7 +232,8 @@ class Simulation:
         r = spec.radius
         dt = self.dt
         state = self.state
-        new = step(spec, state, cmd, dt)
+        new = step(spec, state, cmd, dt) if self.actuation is None else self.actuation.step(
+            spec, state, cmd, dt)
         t0, t_new = self.t, (self.steps + 1) * dt
         a = np.array([state.x, state.y])
         b = np.array([new.x, new.y])
@@ -303,7 +316,8 @@ class Simulation:
             scenario_hash=self.scenario.content_hash(),
             dt_s=self.dt,
             wall_time_s=wall_time_s,
-            extra={**st.extra_dict(), "perception": self.sensor.record()},
+            extra={**st.extra_dict(), "perception": self.sensor.record(),
+                   **({} if self.actuation is None else {"actuation": self.actuation.record()})},
             collision_robot_caused=self.collision_robot_caused if collided else None,
             collision_approach_speed_mps=self.collision_approach_speed_mps if collided else None,
             time_lower_bound_s=bound,

@@ -1,0 +1,90 @@
+"""Imperfect execution: the robot does not drive exactly the twist it achieves on paper.
+
+A real base slips, its wheels see uneven ground and its odometry does not see that, so the
+robot moves by a twist that differs from the one its drive achieves, by an error that persists
+over fractions of a second. :class:`ActuationNoise` moves the robot's pose by the achieved
+(clipped) twist plus a first-order Gauss-Markov error per axis: stationary standard deviations
+``sigma_v`` [m/s] and ``sigma_omega`` [rad/s], correlation time ``tau_s`` (Maybeck, *Stochastic
+Models, Estimation and Control*, vol. 1, 1979, section 4.11), held within ``|v| <= v_max`` and
+``|omega| <= omega_max`` (at full speed the error can only slow the robot). The robot's state
+reports the drive's twist (what odometry measures); the agent sees the pose the robot really
+reached. Seeded per run, on a stream of its own: the same seed gives the same errors whatever
+the sensor draws.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from anyplan.geometry.se2 import unicycle_arc, wrap_angle
+from anyplan.world.robot import Command, RobotSpec, RobotState, clip_command
+
+__all__ = ["ACTUATION_STREAM", "ACTUATION_TAU_S", "ActuationNoise"]
+
+#: The second entry of the actuation generator's seed, ``default_rng((seed, ACTUATION_STREAM))``
+#: (the sensor's noise has a stream of its own).
+ACTUATION_STREAM = 0xAC7
+
+#: Correlation time [s] of the execution error: slip and lag last a few control periods.
+ACTUATION_TAU_S = 0.5
+
+
+class ActuationNoise:
+    """The execution error of one run.
+
+    Args:
+        sigma_v: Stationary standard deviation [m/s] of the speed error (>= 0).
+        sigma_omega: Stationary standard deviation [rad/s] of the turn-rate error (>= 0).
+        seed: The run's seed.
+        tau_s: Correlation time [s] of both errors (> 0).
+
+    Examples:
+        The same seed draws the same errors:
+
+        >>> from anyplan.world.robot import RobotSpec
+        >>> spec = RobotSpec((0.0, 0.0, 0.0), (5.0, 0.0), radius=0.3, v_max=1.0, omega_max=1.0,
+        ...                  a_max=1.0, alpha_max=2.0)
+        >>> runs = [ActuationNoise(0.1, 0.1, seed=3) for _ in range(2)]
+        >>> s = [RobotState(0.0, 0.0, 0.0, 0.5, 0.0)] * 2
+        >>> for _ in range(10):
+        ...     s = [n.step(spec, x, Command(0.5, 0.0), 0.05) for n, x in zip(runs, s)]
+        >>> s[0] == s[1] and s[0].x != 0.5 * 10 * 0.05
+        True
+    """
+
+    def __init__(self, sigma_v: float, sigma_omega: float, seed: int,
+                 tau_s: float = ACTUATION_TAU_S) -> None:
+        for name, val in (("sigma_v", sigma_v), ("sigma_omega", sigma_omega)):
+            if not (math.isfinite(val) and val >= 0.0):
+                raise ValueError(f"{name}: must be >= 0, got {val!r}")
+        if not (math.isfinite(tau_s) and tau_s > 0.0):
+            raise ValueError(f"tau_s: must be > 0, got {tau_s!r}")
+        self.sigma = np.array([float(sigma_v), float(sigma_omega)])
+        self.tau_s = float(tau_s)
+        self.seed_sequence = (int(seed), ACTUATION_STREAM)
+        self.rng = np.random.default_rng(list(self.seed_sequence))
+        # the stationary state: the first step's error is drawn from the process's own spread
+        self.error = self.sigma * self.rng.standard_normal(2)
+        #: The twist the robot moved by in the last step (the drive's plus the error).
+        self.ground = Command(0.0, 0.0)
+
+    def record(self) -> dict[str, object]:
+        """What to store in ``result.extra["actuation"]``."""
+        return {"sigma_v_mps": float(self.sigma[0]), "sigma_omega_radps": float(self.sigma[1]),
+                "tau_s": self.tau_s, "seed": list(self.seed_sequence)}
+
+    def step(self, spec: RobotSpec, state: RobotState, cmd: Command, dt: float) -> RobotState:
+        """Advance the robot by ``dt`` [s]: the drive achieves ``cmd`` clipped to the limits
+        (:func:`~anyplan.world.robot.clip_command`), the pose moves by that twist plus this
+        step's error, held within ``v_max`` and ``omega_max`` (the unicycle integrated exactly),
+        and the state reports the drive's twist."""
+        rho = math.exp(-dt / self.tau_s)
+        self.error = rho * self.error + math.sqrt(1.0 - rho * rho) * self.sigma * self.rng.standard_normal(2)
+        c = clip_command(spec, state, cmd, dt)
+        v = min(max(c.v + float(self.error[0]), -spec.v_max), spec.v_max)
+        w = min(max(c.omega + float(self.error[1]), -spec.omega_max), spec.omega_max)
+        self.ground = Command(v, w)
+        x, y, th = unicycle_arc(state.x, state.y, state.theta, v, w, dt)
+        return RobotState(x, y, float(wrap_angle(th)), c.v, c.omega)
