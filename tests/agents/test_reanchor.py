@@ -108,3 +108,27 @@ def test_an_undisturbed_run_is_never_off_its_reference():
 def test_bad_reanchor_distance(value):
     with pytest.raises(ValueError, match="reanchor_m"):
         make_agent("st-bitstar", reanchor_m=value)
+
+
+def test_off_its_reference_the_robot_is_not_offered_the_motion_in_use():
+    # Keeping the motion in use (a guard's or a fallback's "keep") would keep a motion whose
+    # checks are about a place the robot is not.
+    cls = type(make_agent("st-bitstar"))
+    agent = make_agent("st-bitstar", **deterministic_settings(cls, "st-bitstar"))
+    sc = _room()
+    sim = Simulation(sc, SimConfig(), 0)
+    agent.reset(sc.static_only(), np.random.default_rng(0))
+    while sim.t < _PUSH_S - 1e-9:
+        sim.step(agent.act(sim.observation()))
+    assert agent._in_use() is agent.trajectory is not None
+    s = sim.state
+    sim.state = RobotState(s.x - 0.5, s.y, s.theta, s.v, s.omega)  # held back 0.5 m
+    obs = sim.observation()
+    in_use = agent.trajectory
+    sim.step(agent.act(obs))
+    assert agent._off_reference and agent._in_use() is None
+    assert agent.trajectory is in_use and agent.pending is not None  # a new motion is coming
+    t_switch, motion = agent.pending
+    st = motion.state(t_switch)
+    robot = agent._state_at(obs, t_switch)
+    assert math.hypot(st.x - robot.x, st.y - robot.y) < 1e-6

@@ -133,11 +133,19 @@ class ReplanningAgent(Agent):
         off = self.reanchor_m is not None and (
             math.hypot(ref.x - r.x, ref.y - r.y) > self.reanchor_m
             or abs(float(wrap_angle(r.theta - ref.theta))) > REANCHOR_RAD)
-        if off and not self._off_reference and self.pending is None and self._requested is None:
-            self.record.reanchored_s.append(float(obs.t))
+        if off and not self._off_reference:
+            self.record.reanchored_s.append(float(obs.t))  # once an excursion
+        if (off and self.pending is None and self._requested is None
+                and obs.t - self._last_replan >= self._period() - 1e-9):
+            # (again each check period while it lasts: a replanning may find nothing to start)
             self.request_replan(f"off the reference by {math.hypot(ref.x - r.x, ref.y - r.y):.2f} m: "
                                 "the next motion starts from the robot's own state")
         self._off_reference = off
+
+    def _in_use(self) -> Trajectory | None:
+        """The motion in use, as a candidate to keep: None while the robot is off it
+        (``reanchor_m``), since what is checked along it is not where the robot goes."""
+        return None if self._off_reference else self.trajectory
 
     def _begin_replan(self, obs: Observation) -> tuple[float, float, float, RobotState]:
         """``(dt, d, t_ready, state)``: the control period, the expected delay, the time the new

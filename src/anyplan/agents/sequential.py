@@ -167,7 +167,7 @@ class SequentialBITStarAgent(ReplanningAgent):
         measured delay, a decision that would be ready after ``t_switch`` is made again from the
         state the robot has when it is ready (the motion re-timed from there), as a late plan
         is re-timed (:meth:`_take_up`); it counts as a late plan."""
-        current, planned = self.trajectory, t_switch
+        current, planned = self._in_use(), t_switch
 
         def decide(t_s: float) -> tuple[Any, bool]:
             # Before the agent can act again: one check period, then a replanning's delay.

@@ -511,7 +511,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         if motion is None:
             # (checked at least the fallback horizon ahead: a motion that has ended leaves the
             # robot standing at its end, which is not free when an obstacle is to pass there)
-            if self.trajectory is not None and verify(
+            if self._in_use() is not None and verify(
                     self.trajectory, preds, self.spec.radius, t_from=t_switch,
                     t_until=max(min(self.trajectory.t_end, t_switch + _CHECK_HORIZON_S),
                                 t_switch + self.guard.config.horizon_s)) is None:

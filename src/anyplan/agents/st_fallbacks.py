@@ -30,8 +30,8 @@ __all__ = ["SafetyDecisions"]
 class SafetyDecisions:
     """The safety decisions of an ``st-bitstar`` agent (a mixin: it reads the agent's ``spec``,
     ``obstacles``, ``guard``, ``reference``, ``_period``, ``trajectory``, ``record``,
-    ``passive_safety``, ``reach_extra_mps``, ``reach_min_speed_mps``, ``swerves``, ``_capped`` and
-    ``_state_at``)."""
+    ``passive_safety``, ``reach_extra_mps``, ``reach_min_speed_mps``, ``swerves``, ``_capped``,
+    ``_state_at`` and ``_in_use``)."""
 
     spec: Any
     obstacles: Any
@@ -46,6 +46,7 @@ class SafetyDecisions:
     _capped: Callable[[list[PredictedObstacle]], list[PredictedObstacle]]  # PlanningPredictions'
     _outruns: Callable[[PredictedObstacle], bool]  # PlanningPredictions'
     _state_at: Callable[[Observation, float], RobotState]  # ReplanningAgent's
+    _in_use: Callable[[], Trajectory | None]  # ReplanningAgent's: the motion in use, to keep
     _period: Callable[[], float]  # the check period in force [s] (SpaceTimeBITStarAgent's)
 
     def _guard(self, obs: Observation, t_switch: float, motion: Trajectory | None,
@@ -63,7 +64,7 @@ class SafetyDecisions:
         state = self._state_at(obs, t_switch)
         reach = self._reach(observed, t_switch, state)
         # the guard's own fallback is not asked for: _evasions ranks its candidates with more
-        dec = self.guard.decide(t_switch, motion, self.trajectory, state, safe, commit, reach,
+        dec = self.guard.decide(t_switch, motion, self._in_use(), state, safe, commit, reach,
                                 fallback=False)
         if dec.kind in ("motion", "keep"):
             if dec.rule != "stoppable":
@@ -77,7 +78,7 @@ class SafetyDecisions:
                                               f"{dec.first_collision_s:.2f} s; an evasion is free")
         else:
             (kind, tr, clear), why = self._evasions(t_switch, state, safe, motion,
-                                                    self.trajectory, reach), dec.reason or reason
+                                                    self._in_use(), reach), dec.reason or reason
         self.record.fallbacks.append({"t": float(obs.t), "kind": kind, "reason": why,
                                       "predicted_clearance_m": finite_or_none(clear)})
         return kind, tr
@@ -134,7 +135,7 @@ class SafetyDecisions:
             # the guard did not decide: with uncertain discs, the robot outruns every obstacle
             # (PlanningPredictions._outruns), and swerves are offered as among certain ones
             outrun = all(o.growth is None or self._outruns(o) for o in preds)
-            kind, tr, clear = self._evasions(t_switch, state, preds, None, self.trajectory,
+            kind, tr, clear = self._evasions(t_switch, state, preds, None, self._in_use(),
                                              outrun=outrun)
         if kind == "keep":
             return None
