@@ -511,9 +511,9 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         if motion is None:
             # (checked at least the fallback horizon ahead: a motion that has ended leaves the
             # robot standing at its end, which is not free when an obstacle is to pass there)
-            if self._in_use() is not None and verify(
-                    self.trajectory, preds, self.spec.radius, t_from=t_switch,
-                    t_until=max(min(self.trajectory.t_end, t_switch + _CHECK_HORIZON_S),
+            if (cur := self._in_use()) is not None and verify(
+                    cur, preds, self.spec.radius, t_from=t_switch,
+                    t_until=max(min(cur.t_end, t_switch + _CHECK_HORIZON_S),
                                 t_switch + self.guard.config.horizon_s)) is None:
                 return  # the current reference is still free: keep it, try again later
 
