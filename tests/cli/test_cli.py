@@ -80,3 +80,34 @@ def test_core_layers_do_not_import_matplotlib():
             "anyplan.agents.straight; print('matplotlib' in sys.modules)")
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert p.stdout.strip() == "False", p.stderr
+
+
+def test_bench_keeps_runs_with_another_execution_error_apart(tmp_path, capsys):
+    from anyplan.experiments.db import ResultsDB
+
+    db = tmp_path / "x.db"
+
+    def bench(*noise: str) -> int:
+        return main(["bench", "--suite", "paper-1", "--planners", "straight", "--runs", "1",
+                     "--jobs", "1", "--db", str(db), "--no-progress", "--time-limit", "2", *noise])
+
+    assert bench() == 0
+    assert bench("--actuation-noise", "0.02,0.01") == 0  # another row, its own run
+    assert bench("--actuation-noise", "0.020,0.010") == 2  # the same: stored already
+    assert "already holds 1 of these 1 runs" in capsys.readouterr().err
+    with ResultsDB(db, readonly=True) as d:
+        runs = sorted(d.runs(), key=lambda r: r["settings"])
+        assert [r["settings"] for r in runs] == [
+            "", "actuation.sigma_v = 0.02;actuation.sigma_omega = 0.01;"]
+        extra = [d.result(r["id"])["extra"] for r in runs]
+    assert "actuation" not in extra[0]
+    assert extra[1]["actuation"]["sigma_v_mps"] == 0.02
+
+
+def test_run_records_its_execution_error_with_its_settings(tmp_path):
+    out = tmp_path / "r"
+    assert main(["run", "paper-1", "--planner", "straight", "--out", str(out), "--no-plot",
+                 "--time-limit", "2", "--actuation-noise", "0.02,0.01", "--seed", "4"]) == 1
+    extra = json.loads((out / "result.json").read_text())["extra"]
+    assert extra["settings"] == "actuation.sigma_v = 0.02;actuation.sigma_omega = 0.01;"
+    assert extra["actuation"]["seed"][0] == 4

@@ -52,6 +52,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="simulation step [s], in [0.001, 0.05] (default 0.05)")
     p.add_argument("--time-limit", type=checks.time_limit, default=None,
                    help="simulated time limit [s] (default: each scenario's)")
+    p.add_argument("--actuation-noise", type=checks.actuation_noise, default=(0.0, 0.0),
+                   metavar="SV,SW", help="the robot drives its commands with a correlated error of "
+                   "these spreads [m/s, rad/s] (as anyplan run; default 0,0: exactly)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     from anyplan.cli.perception_opts import add_perception_options, add_tracker_option
 
@@ -175,7 +178,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from anyplan.simulation.simulator import SimConfig
 
     try:
-        cfg = SimConfig(dt=args.dt, time_limit=args.time_limit, tracker=tracker)
+        cfg = SimConfig(dt=args.dt, time_limit=args.time_limit, tracker=tracker,
+                        actuation_sigma_v=args.actuation_noise[0],
+                        actuation_sigma_omega=args.actuation_noise[1])
         for sc in scenarios:
             cfg.steps(sc.time_limit)
     except ValueError as exc:
@@ -195,7 +200,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         sys.stderr.write(f"anyplan: bench stopped: {exc}\n")
         return 1
     hashes = {sc.content_hash() for sc in scenarios}
-    configs = {(p.name, agent_settings_string(p.config, tracker)) for p in planners}
+    configs = {(p.name, agent_settings_string(p.config, tracker, args.actuation_noise)) for p in planners}
     with ResultsDB(db_path, readonly=True) as db:
         runs = [r for r in db.runs()
                 if r["scenario_hash"] in hashes and str(r["experiment_seed"]) == str(args.seed)

@@ -89,12 +89,20 @@ def settings_string(config: Mapping[str, Any]) -> str:
     return "".join(f"{k} = {json.dumps(config[k], sort_keys=True)};" for k in sorted(config))
 
 
-def agent_settings_string(config: Mapping[str, Any], tracker: Sequence[tuple[str, float]] = ()) -> str:
+def agent_settings_string(config: Mapping[str, Any], tracker: Sequence[tuple[str, float]] = (),
+                          actuation: tuple[float, float] = (0.0, 0.0)) -> str:
     """The settings string of a benchmarked agent: its planner's (:func:`settings_string`), then
     its tracker's (``SimConfig.tracker``, ``anyplan bench --tracker``) as ``tracker.NAME = VALUE;``
-    in name order, so that runs with other tracker settings are another planner row."""
-    return settings_string(config) + "".join(
+    in name order, then the robot's execution error when there is one (``SimConfig``'s
+    ``actuation_sigma_v``, ``actuation_sigma_omega``; ``--actuation-noise``) as
+    ``actuation.sigma_v = V;actuation.sigma_omega = W;``: runs with other tracker settings or
+    another execution error are another planner row."""
+    out = settings_string(config) + "".join(
         f"tracker.{k} = {json.dumps(float(v))};" for k, v in sorted(tracker))
+    if any(float(a) != 0.0 for a in actuation):
+        out += (f"actuation.sigma_v = {json.dumps(float(actuation[0]))};"
+                f"actuation.sigma_omega = {json.dumps(float(actuation[1]))};")
+    return out
 
 
 def _fin(x: Any) -> float | None:

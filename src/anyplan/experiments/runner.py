@@ -326,9 +326,11 @@ def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], ru
             exp_ids[h] = db.experiment_id(key, scenario_json=json.dumps(sc.to_dict()),
                                           moving_obstacles=len(sc.moving_obstacles), runcount=runs,
                                           suite=suite)
-        # the tracker's settings (the same for every task) are part of each planner's row
+        # the tracker's settings and the execution error (the same for every task) are part of
+        # each planner's row
+        act = (sim.actuation_sigma_v, sim.actuation_sigma_omega)
         plan_ids = {(p.name, settings_string(p.config)): db.planner_id(
-            p.name, agent_settings_string(p.config, sim.tracker)) for p in planners}
+            p.name, agent_settings_string(p.config, sim.tracker, act)) for p in planners}
         done = db.done_keys()
         tasks = []
         for t in all_tasks:
