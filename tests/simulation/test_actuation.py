@@ -53,10 +53,16 @@ def test_zero_spread_is_the_exact_step():
 
 def test_the_error_has_the_stated_spread_and_correlation_and_keeps_the_limits():
     sv, sw, dt = 0.05, 0.1, 0.05
-    tw = _drive(ActuationNoise(sv, sw, seed=7), Command(0.5, 0.0), 40_000, dt)
-    err = tw - np.array([0.5, 0.0])
+    # half the top speed and half the top turn rate: full motion, the full spreads
+    cmd = Command(0.5 * _SPEC.v_max, 0.5 * _SPEC.omega_max)
+    tw = _drive(ActuationNoise(sv, sw, seed=7), cmd, 40_000, dt)
+    err = tw - np.array([cmd.v, cmd.omega])
     assert err.std(axis=0) == pytest.approx([sv, sw], rel=0.1)
     assert abs(err.mean(axis=0)[0]) < 0.1 * sv
+    # a quarter of the top speed alone: a quarter of the spreads
+    slow = _drive(ActuationNoise(sv, sw, seed=7), Command(0.25 * _SPEC.v_max, 0.0), 40_000, dt)
+    assert (slow - np.array([0.25 * _SPEC.v_max, 0.0])).std(axis=0) == pytest.approx(
+        [0.25 * sv, 0.25 * sw], rel=0.1)
     rho = math.exp(-dt / ACTUATION_TAU_S)
     lag1 = [np.corrcoef(err[:-1, k], err[1:, k])[0, 1] for k in range(2)]
     assert lag1 == pytest.approx([rho, rho], abs=0.02)
@@ -64,6 +70,14 @@ def test_the_error_has_the_stated_spread_and_correlation_and_keeps_the_limits():
     top = _drive(ActuationNoise(0.2, 0.2, seed=7), Command(_SPEC.v_max, _SPEC.omega_max), 2_000)
     assert top[:, 0].max() <= _SPEC.v_max and top[:, 1].max() <= _SPEC.omega_max
     assert top[:, 0].mean() < _SPEC.v_max - 0.05
+
+
+def test_a_robot_at_rest_does_not_drift():
+    noise, s = ActuationNoise(0.5, 0.5, seed=1), RobotState(1.0, 2.0, 0.3)
+    for _ in range(200):
+        s = noise.step(_SPEC, s, Command(0.0, 0.0), 0.05)
+    assert (s.x, s.y, s.v, s.omega) == (1.0, 2.0, 0.0, 0.0)
+    assert s.theta == pytest.approx(0.3, abs=1e-12)  # (wrapped to [-pi, pi) at each step)
 
 
 def test_the_error_is_seeded_on_a_stream_of_its_own():

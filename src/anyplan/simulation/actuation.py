@@ -2,14 +2,16 @@
 
 A real base slips, its wheels see uneven ground and its odometry does not see that, so the
 robot moves by a twist that differs from the one its drive achieves, by an error that persists
-over fractions of a second. :class:`ActuationNoise` moves the robot's pose by the achieved
-(clipped) twist plus a first-order Gauss-Markov error per axis: stationary standard deviations
-``sigma_v`` [m/s] and ``sigma_omega`` [rad/s], correlation time ``tau_s`` (Maybeck, *Stochastic
-Models, Estimation and Control*, vol. 1, 1979, section 4.11), held within ``|v| <= v_max`` and
-``|omega| <= omega_max`` (at full speed the error can only slow the robot). The robot's state
-reports the drive's twist (what odometry measures); the agent sees the pose the robot really
-reached. Seeded per run, on a stream of its own: the same seed gives the same errors whatever
-the sensor draws.
+over fractions of a second and grows with the motion. :class:`ActuationNoise` moves the pose by
+the achieved (clipped) twist plus a first-order Gauss-Markov error per axis (correlation time
+``tau_s``; Maybeck, *Stochastic Models, Estimation and Control*, vol. 1, 1979, section 4.11)
+whose spreads, ``sigma_v`` [m/s] and ``sigma_omega`` [rad/s] at full speed or turn rate, scale
+with ``min(1, |v| / v_max + |omega| / omega_max)``: a robot at rest does not drift (the error
+grows with the motion, as in the velocity motion model of Thrun, Burgard & Fox, *Probabilistic
+Robotics*, 2005, section 5.3). The twist stays within ``v_max`` and ``omega_max`` (at full
+speed the error can only slow the robot). The state reports the drive's twist (what odometry
+measures); the agent sees the pose the robot really reached. Seeded per run, on a stream of its
+own.
 """
 
 from __future__ import annotations
@@ -35,8 +37,9 @@ class ActuationNoise:
     """The execution error of one run.
 
     Args:
-        sigma_v: Stationary standard deviation [m/s] of the speed error (>= 0).
-        sigma_omega: Stationary standard deviation [rad/s] of the turn-rate error (>= 0).
+        sigma_v: Stationary standard deviation [m/s] of the speed error at full motion (>= 0).
+        sigma_omega: Stationary standard deviation [rad/s] of the turn-rate error at full
+            motion (>= 0).
         seed: The run's seed.
         tau_s: Correlation time [s] of both errors (> 0).
 
@@ -78,13 +81,14 @@ class ActuationNoise:
     def step(self, spec: RobotSpec, state: RobotState, cmd: Command, dt: float) -> RobotState:
         """Advance the robot by ``dt`` [s]: the drive achieves ``cmd`` clipped to the limits
         (:func:`~anyplan.world.robot.clip_command`), the pose moves by that twist plus this
-        step's error, held within ``v_max`` and ``omega_max`` (the unicycle integrated exactly),
-        and the state reports the drive's twist."""
+        step's error scaled by the motion, held within ``v_max`` and ``omega_max`` (the
+        unicycle integrated exactly), and the state reports the drive's twist."""
         rho = math.exp(-dt / self.tau_s)
         self.error = rho * self.error + math.sqrt(1.0 - rho * rho) * self.sigma * self.rng.standard_normal(2)
         c = clip_command(spec, state, cmd, dt)
-        v = min(max(c.v + float(self.error[0]), -spec.v_max), spec.v_max)
-        w = min(max(c.omega + float(self.error[1]), -spec.omega_max), spec.omega_max)
+        scale = min(1.0, abs(c.v) / spec.v_max + abs(c.omega) / spec.omega_max)
+        v = min(max(c.v + scale * float(self.error[0]), -spec.v_max), spec.v_max)
+        w = min(max(c.omega + scale * float(self.error[1]), -spec.omega_max), spec.omega_max)
         self.ground = Command(v, w)
         x, y, th = unicycle_arc(state.x, state.y, state.theta, v, w, dt)
         return RobotState(x, y, float(wrap_angle(th)), c.v, c.omega)
