@@ -54,7 +54,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="simulated time limit [s] (default: each scenario's)")
     p.add_argument("--actuation-noise", type=checks.actuation_noise, default=(0.0, 0.0),
                    metavar="SV,SW", help="the robot drives its commands with a correlated error of "
-                   "these spreads [m/s, rad/s] (as anyplan run; default 0,0: exactly)")
+                   "these spreads [m/s, rad/s] at full speed (as anyplan run; default 0,0: exactly)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     from anyplan.cli.perception_opts import add_perception_options, add_tracker_option
 

@@ -48,7 +48,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="simulated time limit [s] (default: the scenario's)")
     p.add_argument("--actuation-noise", type=checks.actuation_noise, default=(0.0, 0.0),
                    metavar="SV,SW", help="the robot drives its commands with a correlated error of "
-                   "these spreads [m/s, rad/s] (slip, lag; seeded by --seed; default 0,0: exactly)")
+                   "these spreads [m/s, rad/s] at full speed (slip; none at rest; seeded by --seed; "
+                   "default 0,0: exactly)")
     p.add_argument("--no-plot", action="store_true", help="do not write run.png")
     p.add_argument("--format", default="png", choices=("png", "svg", "pdf"),
                    help="picture format: DIR/run.png, run.svg or run.pdf (default png)")
