@@ -72,9 +72,9 @@ class SimConfig:
         check_feasibility: Before the first step, end the run with status ``unreachable`` when
             the visibility graph proves the goal out of reach.
         actuation_sigma_v, actuation_sigma_omega: The robot drives its achieved twist with a
-            correlated error of these stationary spreads [m/s, rad/s]
-            (:class:`~anyplan.simulation.actuation.ActuationNoise`; seeded by the run's seed,
-            recorded in ``result.extra["actuation"]``); 0 and 0: exactly.
+            correlated error of these spreads [m/s, rad/s] at full motion, smaller as it moves
+            less, none at rest (:class:`~anyplan.simulation.actuation.ActuationNoise`; seeded
+            by the run's seed, recorded in ``result.extra["actuation"]``); 0 and 0: exactly.
         tracker: With ``tracked`` perception, settings of the robot's tracker and of its
             uncertain discs as ``(name, value)`` pairs (``anyplan run --tracker KEY=VALUE``;
             the names: :func:`~anyplan.simulation.perception.tracking_setting_names`); the
@@ -92,9 +92,9 @@ class SimConfig:
     check_feasibility: bool = setting(True, doc="end at once when the goal is proven unreachable")
     tracker: tuple[tuple[str, float], ...] = ()
     actuation_sigma_v: float = setting(0.0, lo=0.0, unit="m/s",
-                                       doc="spread of the robot's speed error (0: exact)")
+                                       doc="speed error's spread at full motion (0: exact)")
     actuation_sigma_omega: float = setting(0.0, lo=0.0, unit="rad/s",
-                                           doc="spread of the robot's turn-rate error (0: exact)")
+                                           doc="turn-rate error's spread at full motion (0: exact)")
 
     def __post_init__(self) -> None:
         validate(self)
