@@ -123,3 +123,19 @@ def test_policy_agent_refuses_a_bad_policy():
     with pytest.raises(ValueError, match="cannot load"):
         make_agent("policy", policy="tests.gym.policies:nothing")
     assert ObservationEncoder((0, 0), 0).size == 8
+
+
+def test_an_execution_error_is_seeded_with_the_episode():
+    def positions(noise: tuple[float, float], seed: int) -> np.ndarray:
+        env = gymnasium.make("anyplan/Nav-v0", scenario="paper-1", actuation_noise=noise).unwrapped
+        env.reset(seed=seed)
+        action = np.array([0.4, 0.1], dtype=np.float32)  # full speed (the P3-DX), turning
+        for _ in range(40):
+            env.step(action)
+        return np.array([env.sim.state.x, env.sim.state.y])
+
+    exact = positions((0.0, 0.0), 3)
+    noisy = positions((0.05, 0.05), 3)
+    assert np.array_equal(noisy, positions((0.05, 0.05), 3))  # the same seed, the same error
+    assert not np.array_equal(noisy, positions((0.05, 0.05), 4))
+    assert 0.0 < np.hypot(*(noisy - exact)) < 0.5

@@ -46,6 +46,9 @@ class NavEnv(gymnasium.Env):
         progress_weight, time_penalty, goal_reward, collision_penalty: Reward terms.
         announce_motions: As :class:`~anyplan.simulation.SimConfig` (not in the vector; kept for
             parity with the planners' runs).
+        actuation_noise: The robot's execution error, spreads (m/s, rad/s) at full motion
+            (``SimConfig.actuation_sigma_v``, ``actuation_sigma_omega``; seeded with the
+            episode's seed, as the sensor); (0, 0): the robot drives its actions exactly.
     """
 
     metadata = {"render_modes": []}  # noqa: RUF012 - gymnasium's convention
@@ -55,8 +58,11 @@ class NavEnv(gymnasium.Env):
     def __init__(self, scenario: ScenarioLike | Sequence[ScenarioLike] = "paper-3", max_obstacles: int = 8,
                  dt: float = 0.05, time_limit: float | None = None, progress_weight: float = 1.0,
                  time_penalty: float = 0.01, goal_reward: float = 10.0, collision_penalty: float = 10.0,
-                 announce_motions: bool = True) -> None:
-        self.config = SimConfig(dt=dt, time_limit=time_limit, announce_motions=announce_motions)
+                 announce_motions: bool = True,
+                 actuation_noise: tuple[float, float] = (0.0, 0.0)) -> None:
+        self.config = SimConfig(dt=dt, time_limit=time_limit, announce_motions=announce_motions,
+                                actuation_sigma_v=actuation_noise[0],
+                                actuation_sigma_omega=actuation_noise[1])
         self.random_worlds = isinstance(scenario, str) and scenario == "random"
         if self.random_worlds:
             from anyplan.experiments.generate import random_scenario
