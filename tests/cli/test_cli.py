@@ -104,6 +104,21 @@ def test_bench_keeps_runs_with_another_execution_error_apart(tmp_path, capsys):
     assert extra[1]["actuation"]["sigma_v_mps"] == 0.02
 
 
+def test_run_summary_tells_how_far_the_robot_strayed_from_its_references(tmp_path, capsys):
+    def tracking_lines(*extra: str) -> list[str]:
+        assert main(["run", "paper-1", "--out", str(tmp_path / "r"), "--no-plot", "--deterministic",
+                     *extra]) == 0
+        out = capsys.readouterr().out
+        return [ln for ln in out.splitlines() if ln.strip().startswith("tracking")]
+
+    assert tracking_lines() == []  # an exact robot: nothing to tell
+    (line,) = tracking_lines("--actuation-noise", "0.05,0.05")
+    extra = json.loads((tmp_path / "r" / "result.json").read_text())["extra"]
+    n = len(extra["reanchored_s"])
+    assert n > 0 and f"{extra['tracking_max_m']:.3f} m from the reference at most" in line
+    assert f"off it {n} time" in line
+
+
 def test_run_records_its_execution_error_with_its_settings(tmp_path):
     out = tmp_path / "r"
     assert main(["run", "paper-1", "--planner", "straight", "--out", str(out), "--no-plot",

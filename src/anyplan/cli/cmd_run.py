@@ -177,6 +177,16 @@ def _count(n: int, noun: str) -> str:
     return f"{n} {noun}" + ("" if n == 1 else "s")
 
 
+def _tracking_line(extra: dict) -> str:
+    """How far the robot strayed from its references, and how often it planned from its own
+    state instead (``reanchored_s``)."""
+    n = len(extra.get("reanchored_s") or ())
+    worst = extra.get("tracking_max_m")
+    off = (f"off it {_count(n, 'time')} (replanned from the robot's own state)" if n
+           else "never off it")
+    return f"  tracking       {'-' if worst is None else f'{worst:.3f} m'} from the reference at most; {off}"
+
+
 def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
     """A few human-readable lines about a run."""
     pt = result.planning_times_s
@@ -198,6 +208,8 @@ def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
         + (f" ({n_imp} of them improving the motion in use)" if n_imp else ""),
         *([f"  fallbacks      {len(result.extra['fallbacks'])}"]
           if result.extra.get("fallbacks") else []),
+        *([_tracking_line(result.extra)]
+          if result.extra.get("actuation") or result.extra.get("reanchored_s") else []),
         f"  wrote          {out / 'result.json'}",
     ]
     return "\n".join(lines)
