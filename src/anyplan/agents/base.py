@@ -98,8 +98,8 @@ class TrackingLog:
         self._max = 0.0
 
     def add(self, reference_xy: tuple[float, float], robot: RobotState,
-            into: TrackedStats | dict[str, Any]) -> None:
-        """Record one control step's error."""
+            into: TrackedStats | dict[str, Any]) -> float:
+        """Record one control step's error; returns it [m]."""
         err = math.hypot(reference_xy[0] - robot.x, reference_xy[1] - robot.y)
         self._sq += err * err
         self._n += 1
@@ -110,6 +110,7 @@ class TrackingLog:
         else:
             into.tracking_rms_m = math.sqrt(self._sq / self._n)
             into.tracking_max_m = self._max
+        return err
 
 
 class Agent(abc.ABC):

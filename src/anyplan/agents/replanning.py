@@ -129,16 +129,15 @@ class ReplanningAgent(Agent):
         (``reanchor_m``); if it is, ask for a replanning (from the robot's own state)."""
         ref = traj.state(obs.t)
         r = obs.robot
-        self.tracking.add((ref.x, ref.y), r, self.record)
+        err = self.tracking.add((ref.x, ref.y), r, self.record)
         off = self.reanchor_m is not None and (
-            math.hypot(ref.x - r.x, ref.y - r.y) > self.reanchor_m
-            or abs(float(wrap_angle(r.theta - ref.theta))) > REANCHOR_RAD)
+            err > self.reanchor_m or abs(float(wrap_angle(r.theta - ref.theta))) > REANCHOR_RAD)
         if off and not self._off_reference:
             self.record.reanchored_s.append(float(obs.t))  # once an excursion
         if (off and self.pending is None and self._requested is None
                 and obs.t - self._last_replan >= self._period() - 1e-9):
             # (again each check period while it lasts: a replanning may find nothing to start)
-            self.request_replan(f"off the reference by {math.hypot(ref.x - r.x, ref.y - r.y):.2f} m: "
+            self.request_replan(f"off the reference by {err:.2f} m: "
                                 "the next motion starts from the robot's own state")
         self._off_reference = off
 

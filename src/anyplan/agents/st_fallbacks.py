@@ -44,7 +44,7 @@ class SafetyDecisions:
     reach_min_speed_mps: float
     swerves: bool
     _capped: Callable[[list[PredictedObstacle]], list[PredictedObstacle]]  # PlanningPredictions'
-    _outruns: Callable[[PredictedObstacle], bool]  # PlanningPredictions'
+    _in_full: Callable[[PredictedObstacle], bool]  # PlanningPredictions'
     _state_at: Callable[[Observation, float], RobotState]  # ReplanningAgent's
     _in_use: Callable[[], Trajectory | None]  # ReplanningAgent's: the motion in use, to keep
     _period: Callable[[], float]  # the check period in force [s] (SpaceTimeBITStarAgent's)
@@ -133,8 +133,9 @@ class SafetyDecisions:
             kind, clear = "brake-hold", math.inf
         else:
             # the guard did not decide: with uncertain discs, the robot outruns every obstacle
-            # (PlanningPredictions._outruns), and swerves are offered as among certain ones
-            outrun = all(o.growth is None or self._outruns(o) for o in preds)
+            # (none is checked in full: PlanningPredictions._in_full), and swerves are offered as
+            # among certain ones
+            outrun = not any(self._in_full(o) for o in preds)
             kind, tr, clear = self._evasions(t_switch, state, preds, None, self._in_use(),
                                              outrun=outrun)
         if kind == "keep":

@@ -132,8 +132,11 @@ class PlanningPredictions:
         a horizon (``"horizon"``), or never."""
         if self.guard_mode == "horizon":
             return True
-        return self.guard_mode == "growth" and any(
-            o.growth is not None and not self._outruns(o) for o in safe)
+        return self.guard_mode == "growth" and any(self._in_full(o) for o in safe)
+
+    def _in_full(self, o: PredictedObstacle) -> bool:
+        """Whether the guard checks the full growth of ``o``: uncertain, and not outrun."""
+        return o.growth is not None and not self._outruns(o)
 
     def _capped(self, preds: list[PredictedObstacle]) -> list[PredictedObstacle]:
         """``preds`` with their extra radius capped at ``plan_extra_m`` (what paths are planned

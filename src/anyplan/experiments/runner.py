@@ -328,9 +328,8 @@ def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], ru
                                           suite=suite)
         # the tracker's settings and the execution error (the same for every task) are part of
         # each planner's row
-        act = (sim.actuation_sigma_v, sim.actuation_sigma_omega)
         plan_ids = {(p.name, settings_string(p.config)): db.planner_id(
-            p.name, agent_settings_string(p.config, sim.tracker, act)) for p in planners}
+            p.name, agent_settings_string(p.config, sim.tracker, sim.actuation)) for p in planners}
         done = db.done_keys()
         tasks = []
         for t in all_tasks:

@@ -96,6 +96,11 @@ class SimConfig:
     actuation_sigma_omega: float = setting(0.0, lo=0.0, unit="rad/s",
                                            doc="turn-rate error's spread at full motion (0: exact)")
 
+    @property
+    def actuation(self) -> tuple[float, float]:
+        """``(actuation_sigma_v, actuation_sigma_omega)`` [m/s, rad/s]."""
+        return self.actuation_sigma_v, self.actuation_sigma_omega
+
     def __post_init__(self) -> None:
         validate(self)
         try:
