@@ -29,14 +29,16 @@ Usage::
     python benchmarks/unknown.py [--only dynabarn,crowds,gaps,prediction] [--modes twist,tracked]
         [--planners st-bitstar,seq-bitstar,dovs,orca] [--worlds 20-59] [--windows 9] [--seeds 1]
         [--crowd-modes tracked,twist,oracle] [--sensor-noise M] [--sensor-rate HZ]
-        [--actuation-noise SV,SW] [--jobs 2] [--set [PLANNER:]KEY=VALUE ...] [--deterministic]
+        [--actuation-noise SV,SW] [--localization-noise SXY,STH]
+        [--jobs 2] [--set [PLANNER:]KEY=VALUE ...] [--deterministic]
         [--tracker KEY=VALUE ...]
 
 ``--set`` and ``--deterministic`` are ``anyplan bench``'s (agent settings; a fixed planning delay
 and budgets, so that a run depends only on its scenario, settings and seed, not on the load).
 ``--tracker`` is ``anyplan run``'s and ``anyplan bench``'s: settings of the tracker and its
 uncertain discs for every ``tracked`` run and for the prediction scores. ``--actuation-noise``
-is ``anyplan run``'s: the robot drives its commands with a seeded, correlated error.
+is ``anyplan run``'s: the robot drives its commands with a seeded, correlated error;
+``--localization-noise`` too: the robot believes its pose (and what it senses) off by one.
 """
 
 from __future__ import annotations
@@ -59,20 +61,21 @@ if not SHARED.is_dir():
 
 def _run(task: tuple[str, dict[str, Any], str, str, int, dict[str, Any],
                      tuple[tuple[str, float], ...], tuple[float | None, float | None],
-                     tuple[float, float]]
+                     tuple[float, float, float, float]]
          ) -> dict[str, Any]:
     from anyplan.agents import make_agent
     from anyplan.simulation import SimConfig, simulate
     from anyplan.simulation.perception import override_sensing
     from anyplan.world.scenario import scenario_from_dict
 
-    suite, data, planner, mode, seed, config, tracker, (noise_m, rate_hz), (sv, sw) = task
+    suite, data, planner, mode, seed, config, tracker, (noise_m, rate_hz), (sv, sw, sxy, sth) = task
     sc = scenario_from_dict(data, f"<{data['name']}>")
     sc = override_sensing(sc, mode, noise_m if mode == "tracked" else None,
                           rate_hz if mode == "tracked" else None)
     try:
         res = simulate(sc, make_agent(planner, **config), seed=seed,
-                       config=SimConfig(tracker=tracker, actuation_sigma_v=sv, actuation_sigma_omega=sw))
+                       config=SimConfig(tracker=tracker, actuation_sigma_v=sv, actuation_sigma_omega=sw,
+                                        localization_sigma_xy=sxy, localization_sigma_theta=sth))
     except Exception as exc:  # noqa: BLE001 - a planner failure is a result, reported
         return {"suite": suite, "mode": mode, "planner": planner, "scenario": sc.name, "seed": seed,
                 "status": f"error: {type(exc).__name__}", "times": []}
@@ -250,10 +253,13 @@ def main(argv: list[str] | None = None) -> int:
                     help="detection noise [m] (sigma) of every tracked run (default: the scenario's)")
     ap.add_argument("--sensor-rate", type=float, default=None, metavar="HZ",
                     help="detection rate [Hz] of every tracked run (default: the scenario's)")
-    from anyplan.cli.checks import actuation_noise
+    from anyplan.cli.checks import actuation_noise, localization_noise
 
     ap.add_argument("--actuation-noise", type=actuation_noise, default=(0.0, 0.0), metavar="SV,SW",
                     help="the robot's execution error, spreads [m/s, rad/s] (as anyplan run)")
+    ap.add_argument("--localization-noise", type=localization_noise, default=(0.0, 0.0),
+                    metavar="SXY,STH", help="the robot's localization error, spreads [m, rad] "
+                    "(as anyplan run)")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=None, help="also write the Markdown report here")
     ap.add_argument("--rows", default=None, help="also write every run's row as JSON here")
@@ -306,17 +312,18 @@ def main(argv: list[str] | None = None) -> int:
         print("\n".join(report), flush=True)
     tasks = []
     seeds = range(a.first_seed, a.first_seed + a.seeds)
+    errors = (*a.actuation_noise, *a.localization_noise)
     if "dynabarn" in only:
         for d in _dynabarn(parse_worlds(a.worlds)):
-            tasks += [("dynabarn", d, p, m, s, configs[p], tracker, sensing, a.actuation_noise) for m in modes
+            tasks += [("dynabarn", d, p, m, s, configs[p], tracker, sensing, errors) for m in modes
                       for p in planners for s in seeds]
     if "crowds" in only:
         for tag, d in _crowds(a.windows):
-            tasks += [(tag, d, p, m, s, configs[p], tracker, sensing, a.actuation_noise) for m in crowd_modes
+            tasks += [(tag, d, p, m, s, configs[p], tracker, sensing, errors) for m in crowd_modes
                       for p in planners for s in seeds]
     if "gaps" in only:
         for d in _gaps(a.gaps):
-            tasks += [("gaps", d, p, "tracked", s, configs[p], tracker, sensing, a.actuation_noise)
+            tasks += [("gaps", d, p, "tracked", s, configs[p], tracker, sensing, errors)
                       for p in planners for s in seeds]
     rows = []
     t0 = time.perf_counter()

@@ -139,3 +139,19 @@ def test_an_execution_error_is_seeded_with_the_episode():
     assert np.array_equal(noisy, positions((0.05, 0.05), 3))  # the same seed, the same error
     assert not np.array_equal(noisy, positions((0.05, 0.05), 4))
     assert 0.0 < np.hypot(*(noisy - exact)) < 0.5
+
+
+def test_a_localization_error_moves_the_observed_pose_not_the_robot():
+    def episode(noise: tuple[float, float], seed: int) -> tuple[np.ndarray, np.ndarray]:
+        env = gymnasium.make("anyplan/Nav-v0", scenario="paper-1", localization_noise=noise).unwrapped
+        obs, _ = env.reset(seed=seed)
+        action = np.array([0.4, 0.1], dtype=np.float32)
+        for _ in range(20):
+            obs, *_ = env.step(action)
+        return obs[6:8].astype(float), np.array([env.sim.state.x, env.sim.state.y])
+
+    (seen0, at0), (seen1, at1) = episode((0.0, 0.0), 3), episode((0.05, 0.02), 3)
+    assert np.array_equal(at0, at1)  # open loop: the robot drives the same way
+    assert np.allclose(seen0, at0, atol=1e-6)  # exact: the vector holds the true position
+    assert 1e-3 < np.hypot(*(seen1 - at1)) < 0.3  # off by the error (float32 rounding aside)
+    assert np.array_equal(seen1, episode((0.05, 0.02), 3)[0])  # seeded with the episode

@@ -24,10 +24,12 @@ from anyplan.config import SettingError
 from anyplan.errors import AnyplanError, one_line, shorten
 from anyplan.world import limits as L
 
-__all__ = ["seed", "time_limit", "sim_step", "actuation_noise", "positive_seconds", "count", "playback_speed",
-           "writable_file", "writable_folder", "safe_name", "PLOT_SUFFIXES", "MAX_RUNS", "MAX_TASKS",
-           "MAX_JOBS", "MAX_PLAN_TIME_S", "MAX_ACTUATION_SIGMA", "SPEED_RANGE", "SIM_FLAGS",
-           "flag_message"]
+__all__ = [
+    "seed", "time_limit", "sim_step", "actuation_noise", "localization_noise", "positive_seconds", "count",
+    "playback_speed", "writable_file", "writable_folder", "safe_name", "PLOT_SUFFIXES", "MAX_RUNS",
+    "MAX_TASKS", "MAX_JOBS", "MAX_PLAN_TIME_S", "MAX_ACTUATION_SIGMA", "MAX_LOCALIZATION_SIGMA",
+    "SPEED_RANGE", "SIM_FLAGS",
+    "flag_message"]
 
 #: :class:`~anyplan.simulation.SimConfig` fields and the flags of ``run`` and ``bench`` that set them.
 SIM_FLAGS = {"dt": "--dt", "time_limit": "--time-limit"}
@@ -99,19 +101,32 @@ def sim_step(text: str) -> float:
 
 #: Largest execution-error spread accepted on the command line (m/s or rad/s).
 MAX_ACTUATION_SIGMA = 10.0
+#: Largest localization-error spread accepted on the command line (m or rad).
+MAX_LOCALIZATION_SIGMA = 10.0
+
+
+def _spread_pair(text: str, names: str, units: str, most: float) -> tuple[float, float]:
+    """Two comma-separated spreads, each in [0, most]."""
+    parts = text.split(",")
+    if len(parts) != 2:
+        raise argparse.ArgumentTypeError(f"expected {names} ({units}), got {shorten(text)}")
+    a, b = (_number(p.strip(), f"a spread in {units.replace(', ', ' or ')}") for p in parts)
+    for x in (a, b):
+        if not 0.0 <= x <= most:
+            raise argparse.ArgumentTypeError(f"spreads must be in [0, {most:g}], got {x:g}")
+    return a, b
 
 
 def actuation_noise(text: str) -> tuple[float, float]:
     """``SIGMA_V,SIGMA_OMEGA``: the robot's execution-error spreads [m/s, rad/s], each in
     [0, MAX_ACTUATION_SIGMA]."""
-    parts = text.split(",")
-    if len(parts) != 2:
-        raise argparse.ArgumentTypeError(f"expected SIGMA_V,SIGMA_OMEGA (m/s, rad/s), got {shorten(text)}")
-    sv, sw = (_number(p.strip(), "a spread in m/s or rad/s") for p in parts)
-    for x in (sv, sw):
-        if not 0.0 <= x <= MAX_ACTUATION_SIGMA:
-            raise argparse.ArgumentTypeError(f"spreads must be in [0, {MAX_ACTUATION_SIGMA:g}], got {x:g}")
-    return sv, sw
+    return _spread_pair(text, "SIGMA_V,SIGMA_OMEGA", "m/s, rad/s", MAX_ACTUATION_SIGMA)
+
+
+def localization_noise(text: str) -> tuple[float, float]:
+    """``SIGMA_XY,SIGMA_THETA``: the robot's localization-error spreads [m per axis, rad], each
+    in [0, MAX_LOCALIZATION_SIGMA]."""
+    return _spread_pair(text, "SIGMA_XY,SIGMA_THETA", "m, rad", MAX_LOCALIZATION_SIGMA)
 
 
 def positive_seconds(text: str) -> float:

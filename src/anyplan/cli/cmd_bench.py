@@ -55,6 +55,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--actuation-noise", type=checks.actuation_noise, default=(0.0, 0.0),
                    metavar="SV,SW", help="the robot drives its commands with a correlated error of "
                    "these spreads [m/s, rad/s] at full speed (as anyplan run; default 0,0: exactly)")
+    p.add_argument("--localization-noise", type=checks.localization_noise, default=(0.0, 0.0),
+                   metavar="SXY,STH", help="the robot believes its pose off by an error of these "
+                   "spreads [m per axis, rad] (as anyplan run; default 0,0: exactly)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     from anyplan.cli.perception_opts import add_perception_options, add_tracker_option
 
@@ -180,7 +183,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
     try:
         cfg = SimConfig(dt=args.dt, time_limit=args.time_limit, tracker=tracker,
                         actuation_sigma_v=args.actuation_noise[0],
-                        actuation_sigma_omega=args.actuation_noise[1])
+                        actuation_sigma_omega=args.actuation_noise[1],
+                        localization_sigma_xy=args.localization_noise[0],
+                        localization_sigma_theta=args.localization_noise[1])
         for sc in scenarios:
             cfg.steps(sc.time_limit)
     except ValueError as exc:
@@ -200,7 +205,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
         sys.stderr.write(f"anyplan: bench stopped: {exc}\n")
         return 1
     hashes = {sc.content_hash() for sc in scenarios}
-    configs = {(p.name, agent_settings_string(p.config, tracker, cfg.actuation)) for p in planners}
+    configs = {(p.name, agent_settings_string(p.config, tracker, cfg.actuation, cfg.localization))
+               for p in planners}
     with ResultsDB(db_path, readonly=True) as db:
         runs = [r for r in db.runs()
                 if r["scenario_hash"] in hashes and str(r["experiment_seed"]) == str(args.seed)

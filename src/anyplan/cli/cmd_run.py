@@ -50,6 +50,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    metavar="SV,SW", help="the robot drives its commands with a correlated error of "
                    "these spreads [m/s, rad/s] at full speed (slip; none at rest; seeded by --seed; "
                    "default 0,0: exactly)")
+    p.add_argument("--localization-noise", type=checks.localization_noise, default=(0.0, 0.0),
+                   metavar="SXY,STH", help="the robot believes its pose off by a slowly wandering "
+                   "error of these spreads [m per axis, rad], and places what it senses with it "
+                   "(seeded by --seed; default 0,0: exactly)")
     p.add_argument("--no-plot", action="store_true", help="do not write run.png")
     p.add_argument("--format", default="png", choices=("png", "svg", "pdf"),
                    help="picture format: DIR/run.png, run.svg or run.pdf (default png)")
@@ -125,7 +129,9 @@ def _run(args: argparse.Namespace) -> int:
     try:
         cfg = SimConfig(dt=args.dt, time_limit=args.time_limit, tracker=tracker,
                         actuation_sigma_v=args.actuation_noise[0],
-                        actuation_sigma_omega=args.actuation_noise[1])
+                        actuation_sigma_omega=args.actuation_noise[1],
+                        localization_sigma_xy=args.localization_noise[0],
+                        localization_sigma_theta=args.localization_noise[1])
         cfg.steps(scenario.time_limit)
     except ValueError as exc:
         raise UsageError(f"run: {checks.flag_message(exc, checks.SIM_FLAGS)}") from None
@@ -153,7 +159,7 @@ def _run(args: argparse.Namespace) -> int:
     result = simulate(scenario, agent, seed=args.seed, config=cfg)
     # the settings given (--set, --deterministic, --tracker), as anyplan bench records them: with
     # the seed and the scenario, what reproduces the run
-    result.extra["settings"] = agent_settings_string(config, cfg.tracker, cfg.actuation)
+    result.extra["settings"] = agent_settings_string(config, cfg.tracker, cfg.actuation, cfg.localization)
     (out / "result.json").write_text(json.dumps(result.to_dict(), indent=1))
     if not args.no_plot:
         from anyplan.viz.run import save_run_figure
@@ -186,6 +192,12 @@ def _tracking_line(extra: dict) -> str:
     return f"  tracking       {'-' if worst is None else f'{worst:.3f} m'} from the reference at most; {off}"
 
 
+def _localization_line(loc: dict) -> str:
+    """How far off the robot believed its position at most, with the error's spreads."""
+    return (f"  localization   believed position off by {loc['max_position_error_m']:.3f} m at most "
+            f"(spreads {loc['sigma_xy_m']:g} m, {loc['sigma_theta_rad']:g} rad)")
+
+
 def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
     """A few human-readable lines about a run."""
     pt = result.planning_times_s
@@ -207,8 +219,10 @@ def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
         + (f" ({n_imp} of them improving the motion in use)" if n_imp else ""),
         *([f"  fallbacks      {len(result.extra['fallbacks'])}"]
           if result.extra.get("fallbacks") else []),
-        *([_tracking_line(result.extra)]
-          if result.extra.get("actuation") or result.extra.get("reanchored_s") else []),
+        *([_tracking_line(result.extra)] if any(result.extra.get(k) for k in (
+            "actuation", "localization", "reanchored_s")) else []),
+        *([_localization_line(result.extra["localization"])]
+          if result.extra.get("localization") else []),
         f"  wrote          {out / 'result.json'}",
     ]
     return "\n".join(lines)

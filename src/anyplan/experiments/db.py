@@ -90,18 +90,24 @@ def settings_string(config: Mapping[str, Any]) -> str:
 
 
 def agent_settings_string(config: Mapping[str, Any], tracker: Sequence[tuple[str, float]] = (),
-                          actuation: tuple[float, float] = (0.0, 0.0)) -> str:
+                          actuation: tuple[float, float] = (0.0, 0.0),
+                          localization: tuple[float, float] = (0.0, 0.0)) -> str:
     """The settings string of a benchmarked agent: its planner's (:func:`settings_string`), then
     its tracker's (``SimConfig.tracker``, ``anyplan bench --tracker``) as ``tracker.NAME = VALUE;``
     in name order, then the robot's execution error when there is one (``SimConfig``'s
     ``actuation_sigma_v``, ``actuation_sigma_omega``; ``--actuation-noise``) as
-    ``actuation.sigma_v = V;actuation.sigma_omega = W;``: runs with other tracker settings or
-    another execution error are another planner row."""
+    ``actuation.sigma_v = V;actuation.sigma_omega = W;``, then its localization error when there
+    is one (``localization_sigma_xy``, ``localization_sigma_theta``; ``--localization-noise``)
+    as ``localization.sigma_xy = S;localization.sigma_theta = T;``: runs with other tracker
+    settings or another execution or localization error are another planner row."""
     out = settings_string(config) + "".join(
         f"tracker.{k} = {json.dumps(float(v))};" for k, v in sorted(tracker))
     if any(float(a) != 0.0 for a in actuation):
         out += (f"actuation.sigma_v = {json.dumps(float(actuation[0]))};"
                 f"actuation.sigma_omega = {json.dumps(float(actuation[1]))};")
+    if any(float(a) != 0.0 for a in localization):
+        out += (f"localization.sigma_xy = {json.dumps(float(localization[0]))};"
+                f"localization.sigma_theta = {json.dumps(float(localization[1]))};")
     return out
 
 

@@ -326,10 +326,11 @@ def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], ru
             exp_ids[h] = db.experiment_id(key, scenario_json=json.dumps(sc.to_dict()),
                                           moving_obstacles=len(sc.moving_obstacles), runcount=runs,
                                           suite=suite)
-        # the tracker's settings and the execution error (the same for every task) are part of
+        # the tracker's settings, the execution and localization errors (the same for every task) are part of
         # each planner's row
         plan_ids = {(p.name, settings_string(p.config)): db.planner_id(
-            p.name, agent_settings_string(p.config, sim.tracker, sim.actuation)) for p in planners}
+            p.name, agent_settings_string(p.config, sim.tracker, sim.actuation,
+                                           sim.localization)) for p in planners}
         done = db.done_keys()
         tasks = []
         for t in all_tasks:

@@ -49,6 +49,10 @@ class NavEnv(gymnasium.Env):
         actuation_noise: The robot's execution error, spreads (m/s, rad/s) at full motion
             (``SimConfig.actuation_sigma_v``, ``actuation_sigma_omega``; seeded with the
             episode's seed, as the sensor); (0, 0): the robot drives its actions exactly.
+        localization_noise: The robot's localization error, spreads (m per axis, rad): the
+            observation's pose, and the obstacles it senses, are where the robot believes them
+            (``SimConfig.localization_sigma_xy``, ``localization_sigma_theta``; seeded with the
+            episode's seed); (0, 0): exactly.
     """
 
     metadata = {"render_modes": []}  # noqa: RUF012 - gymnasium's convention
@@ -59,10 +63,13 @@ class NavEnv(gymnasium.Env):
                  dt: float = 0.05, time_limit: float | None = None, progress_weight: float = 1.0,
                  time_penalty: float = 0.01, goal_reward: float = 10.0, collision_penalty: float = 10.0,
                  announce_motions: bool = True,
-                 actuation_noise: tuple[float, float] = (0.0, 0.0)) -> None:
+                 actuation_noise: tuple[float, float] = (0.0, 0.0),
+                 localization_noise: tuple[float, float] = (0.0, 0.0)) -> None:
         self.config = SimConfig(dt=dt, time_limit=time_limit, announce_motions=announce_motions,
                                 actuation_sigma_v=actuation_noise[0],
-                                actuation_sigma_omega=actuation_noise[1])
+                                actuation_sigma_omega=actuation_noise[1],
+                                localization_sigma_xy=localization_noise[0],
+                                localization_sigma_theta=localization_noise[1])
         self.random_worlds = isinstance(scenario, str) and scenario == "random"
         if self.random_worlds:
             from anyplan.experiments.generate import random_scenario

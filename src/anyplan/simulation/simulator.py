@@ -36,6 +36,7 @@ from anyplan.simulation.contact import (
     static_contact,
 )
 from anyplan.simulation.feasibility import goal_unreachable
+from anyplan.simulation.localization import LocalizationError
 from anyplan.simulation.metrics import moving_obstacle_metrics
 from anyplan.simulation.perception import (
     Sensor,
@@ -75,6 +76,10 @@ class SimConfig:
             correlated error of these spreads [m/s, rad/s] at full motion, smaller as it moves
             less, none at rest (:class:`~anyplan.simulation.actuation.ActuationNoise`; seeded
             by the run's seed, recorded in ``result.extra["actuation"]``); 0 and 0: exactly.
+        localization_sigma_xy, localization_sigma_theta: The agent sees its pose off by a
+            slowly wandering error of these spreads [m per axis, rad], and what its sensor sees
+            off with it (:class:`~anyplan.simulation.localization.LocalizationError`; seeded by
+            the run's seed, recorded in ``result.extra["localization"]``); 0 and 0: exactly.
         tracker: With ``tracked`` perception, settings of the robot's tracker and of its
             uncertain discs as ``(name, value)`` pairs (``anyplan run --tracker KEY=VALUE``;
             the names: :func:`~anyplan.simulation.perception.tracking_setting_names`); the
@@ -95,11 +100,20 @@ class SimConfig:
                                        doc="speed error's spread at full motion (0: exact)")
     actuation_sigma_omega: float = setting(0.0, lo=0.0, unit="rad/s",
                                            doc="turn-rate error's spread at full motion (0: exact)")
+    localization_sigma_xy: float = setting(0.0, lo=0.0, unit="m",
+                                           doc="position estimate's error spread per axis (0: exact)")
+    localization_sigma_theta: float = setting(0.0, lo=0.0, unit="rad",
+                                              doc="heading estimate's error spread (0: exact)")
 
     @property
     def actuation(self) -> tuple[float, float]:
         """``(actuation_sigma_v, actuation_sigma_omega)`` [m/s, rad/s]."""
         return self.actuation_sigma_v, self.actuation_sigma_omega
+
+    @property
+    def localization(self) -> tuple[float, float]:
+        """``(localization_sigma_xy, localization_sigma_theta)`` [m, rad]."""
+        return self.localization_sigma_xy, self.localization_sigma_theta
 
     def __post_init__(self) -> None:
         validate(self)
@@ -136,7 +150,7 @@ class Simulation:
         scenario: The full scenario (truth).
         config: Simulation settings.
         seed: Seed of the sensor's noise (perception modes with noise) and of the robot's
-            execution error (``actuation_sigma_*``).
+            execution and localization errors (``actuation_sigma_*``, ``localization_sigma_*``).
 
     Attributes:
         t: Simulation time [s] of the current state.
@@ -189,6 +203,8 @@ class Simulation:
         self.sensor = Sensor(scenario, effective_sensing(scenario, cfg.announce_motions), seed)
         self.actuation = (ActuationNoise(cfg.actuation_sigma_v, cfg.actuation_sigma_omega, seed)
                           if cfg.actuation_sigma_v > 0.0 or cfg.actuation_sigma_omega > 0.0 else None)
+        self.localization = (LocalizationError(*cfg.localization, seed)
+                             if any(x > 0.0 for x in cfg.localization) else None)
         self.done = False
         self._check_goal()
 
@@ -220,9 +236,14 @@ class Simulation:
         return RunStatus.TIMEOUT if self.done else RunStatus.RUNNING
 
     def observation(self) -> Observation:
-        """What an agent sees now (call it once per step: a sensor may keep state)."""
+        """What an agent sees now (call it once per step: a sensor may keep state): with a
+        localization error, its pose as it believes it, and what it senses placed from there."""
         seen, detections = self.sensor.observe(self.t, self.state)
-        return Observation(self.t, self.state, seen, detections)
+        loc = self.localization
+        if loc is None:
+            return Observation(self.t, self.state, seen, detections)
+        return Observation(self.t, loc.estimate(self.state), loc.observed(self.state, seen),
+                           loc.detected(self.state, detections))
 
     def step(self, cmd: Command) -> None:
         """Clip ``cmd`` to the robot's limits, integrate one step, move the obstacles, test the
@@ -281,6 +302,8 @@ class Simulation:
         self.state, self.t = new, t_new
         self.steps += 1
         self.trajectory.append([self.t, new.x, new.y, new.theta, new.v, new.omega])
+        if self.localization is not None:
+            self.localization.step(dt)
         self.last_hit = hit
         if hit is not None and self.collision_with is None:
             self.collision_with, self.collision_time_s = hit, self.t
@@ -322,7 +345,8 @@ class Simulation:
             dt_s=self.dt,
             wall_time_s=wall_time_s,
             extra={**st.extra_dict(), "perception": self.sensor.record(),
-                   **({} if self.actuation is None else {"actuation": self.actuation.record()})},
+                   **({} if self.actuation is None else {"actuation": self.actuation.record()}),
+                   **({} if self.localization is None else {"localization": self.localization.record()})},
             collision_robot_caused=self.collision_robot_caused if collided else None,
             collision_approach_speed_mps=self.collision_approach_speed_mps if collided else None,
             time_lower_bound_s=bound,
