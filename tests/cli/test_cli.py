@@ -47,6 +47,10 @@ def test_scenarios_lists_builtins(capsys):
     (["run", "paper-1", "--actuation-noise", "0.1"], "expected SIGMA_V,SIGMA_OMEGA"),
     (["run", "paper-1", "--actuation-noise", "0.1,-0.1"], "spreads must be in [0, 10], got -0.1"),
     (["run", "paper-1", "--actuation-noise", "0.1,nan"], "finite"),
+    (["run", "paper-1", "--localization-noise", "0.05"], "expected SIGMA_XY,SIGMA_THETA"),
+    (["run", "paper-1", "--localization-noise", "0.05,-0.01"], "spreads must be in [0, 10], got -0.01"),
+    (["bench", "--localization-noise", "a,b"], "a spread in m or rad"),
+    (["run", "paper-1", "--set", "pose_margin_m=-0.1"], "pose_margin_m: must be >= 0"),
     (["frobnicate"], "invalid choice"),
 ])
 def test_bad_input_exits_2_with_one_line(argv, words, capsys, tmp_path, monkeypatch):
@@ -126,3 +130,27 @@ def test_run_records_its_execution_error_with_its_settings(tmp_path):
     extra = json.loads((out / "result.json").read_text())["extra"]
     assert extra["settings"] == "actuation.sigma_v = 0.02;actuation.sigma_omega = 0.01;"
     assert extra["actuation"]["seed"][0] == 4
+
+
+def test_a_localization_error_gets_its_own_row_and_its_summary_line(tmp_path, capsys):
+    from anyplan.experiments.db import ResultsDB
+
+    db = tmp_path / "x.db"
+    argv = ["bench", "--suite", "paper-1", "--planners", "straight", "--runs", "1", "--jobs", "1",
+            "--db", str(db), "--no-progress", "--time-limit", "2"]
+    assert main(argv) == 0
+    assert main([*argv, "--localization-noise", "0.05,0.01"]) == 0  # another row
+    with ResultsDB(db, readonly=True) as d:
+        runs = sorted(d.runs(), key=lambda r: r["settings"])
+        assert [r["settings"] for r in runs] == [
+            "", "localization.sigma_xy = 0.05;localization.sigma_theta = 0.01;"]
+        loc = d.result(runs[1]["id"])["extra"]["localization"]
+    assert (loc["sigma_xy_m"], loc["sigma_theta_rad"]) == (0.05, 0.01)
+    capsys.readouterr()
+    assert main(["run", "paper-1", "--planner", "straight", "--out", str(tmp_path / "r"),
+                 "--no-plot", "--time-limit", "2", "--localization-noise", "0.05,0.01"]) == 1
+    lines = [ln.strip() for ln in capsys.readouterr().out.splitlines()]
+    extra = json.loads((tmp_path / "r" / "result.json").read_text())["extra"]
+    worst = extra["localization"]["max_position_error_m"]
+    assert (f"localization   believed position off by {worst:.3f} m at most "
+            "(spreads 0.05 m, 0.01 rad)") in lines

@@ -14,6 +14,7 @@ behaviour). Moving obstacles are predicted with a constant twist
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Any
 
@@ -26,6 +27,7 @@ from anyplan.agents.stats import SequentialStats
 from anyplan.agents.warmup import warm_up_kernels
 from anyplan.control.kanayama import KanayamaGains
 from anyplan.planning.sequential import SequentialBITStar, SequentialConfig, SequentialResult
+from anyplan.planning.visgraph import reachable_margin
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
 from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.reference import ReferenceBuilder
@@ -42,6 +44,12 @@ class SequentialBITStarAgent(ReplanningAgent):
         config: Settings of the replanning loop (:class:`SequentialConfig`).
         plan_margin: Extra clearance [m] added to the robot radius for BIT* (static obstacles).
         smooth_margin: Extra clearance [m] the smoothed curve must keep (< plan_margin).
+        pose_margin_m: Extra clearance [m] kept from the static obstacles for the robot's
+            localization error (2-3 standard deviations of its position, the spread its
+            localizer reports): added to ``plan_margin`` and ``smooth_margin``, at reset
+            reduced to what the way from the start to the goal allows
+            (:func:`~anyplan.planning.visgraph.reachable_margin`; the margin taken is
+            ``result.extra["pose_margin_m"]``). 0: none.
         check_period_s: How often [s] the current motion is checked against the predictions.
         min_replan_interval_s: Minimum time [s] between two replannings (unless the predicted
             collision is closer than ``urgent_s``).
@@ -72,13 +80,15 @@ class SequentialBITStarAgent(ReplanningAgent):
                  planning_delay: str | float = "measured", grid_step: float = 0.05,
                  gains: KanayamaGains | None = None, safety: bool = True,
                  safety_config: SafetyConfig | None = None, reanchor_m: float | None = 0.2,
-                 **loop_options: Any) -> None:
+                 pose_margin_m: float = 0.0, **loop_options: Any) -> None:
         if config is None:
             config = SequentialConfig(**loop_options)
         elif loop_options:
             raise ValueError("give either config or loop options, not both")
         if not 0.0 <= smooth_margin <= plan_margin:
             raise ValueError("smooth_margin: must be in [0, plan_margin]")
+        if not (isinstance(pose_margin_m, int | float) and 0.0 <= pose_margin_m < math.inf):
+            raise ValueError(f"pose_margin_m: must be >= 0, got {pose_margin_m!r}")
         super().__init__(check_period_s=check_period_s,
                          min_replan_interval_s=min_replan_interval_s, urgent_s=urgent_s,
                          planning_delay=planning_delay, max_delay_s=config.max_time_s,
@@ -86,6 +96,7 @@ class SequentialBITStarAgent(ReplanningAgent):
         self.config = config
         self.plan_margin = float(plan_margin)
         self.smooth_margin = float(smooth_margin)
+        self.pose_margin_m = float(pose_margin_m)
         self.grid_step = float(grid_step)
         self.safety = bool(safety)
         self.safety_config = safety_config or SafetyConfig(margin=config.margin,
@@ -98,14 +109,24 @@ class SequentialBITStarAgent(ReplanningAgent):
         self.obstacles = scenario.obstacle_set()
         self.rng = rng
         self.predictor = ConstantTwistPredictor()
-        self.loop = SequentialBITStar(self.obstacles, robot_radius=self.spec.radius,
-                                      plan_radius=self.spec.radius + self.plan_margin,
+        spec = self.spec
+        # the localization margin the way to the goal leaves room for: where its narrowest
+        # passage allows less than asked for, half of what it allows (a passage left exactly
+        # as wide as the disc planned for is one BIT*'s samples hardly ever find)
+        extra = None
+        if self.pose_margin_m > 0.0:
+            extra = reachable_margin(self.obstacles, spec.start[:2], spec.goal,
+                                     spec.radius + self.plan_margin, self.pose_margin_m)
+            extra = extra if extra >= self.pose_margin_m else 0.5 * extra
+        self.loop = SequentialBITStar(self.obstacles, robot_radius=spec.radius,
+                                      plan_radius=spec.radius + self.plan_margin + (extra or 0.0),
                                       config=self.config, rng=rng)
-        self.reference = ReferenceBuilder(spec=self.spec, obstacles=self.obstacles,
-                                          smooth_margin=self.smooth_margin,
+        self.reference = ReferenceBuilder(spec=spec, obstacles=self.obstacles,
+                                          smooth_margin=self.smooth_margin + (extra or 0.0),
                                           grid_step=self.grid_step)
         self.guard = SafetyGuard(self.spec, self.obstacles, self.safety_config)
         self._reset_timing(self._new_record())
+        self.record.pose_margin_m = extra
         self._fallback_active = False
         self._commit_s = self.check_period_s + 0.1
 

@@ -110,14 +110,17 @@ class SequentialStats(StatsRecord):
         reanchored_s: Simulated times [s] at which the robot was found off its reference
             (``reanchor_m``) and a replanning from its own state was asked for (left out
             when empty).
+        pose_margin_m: The clearance [m] kept from the static obstacles for the robot's
+            localization error (``pose_margin_m``, as the way to the goal allows; left out
+            when not asked for).
     """
 
     KEYS: ClassVar[tuple[str, ...]] = (
         "statuses", "iterations", "late_plans", "plan_time_s", "motion_time_s", "replan_times_s",
         "waits", "fallbacks", "safety_time_s", "reasons", "progress", "safety", "tracking",
-        *_TRACKING, "reanchored_s")
+        *_TRACKING, "reanchored_s", "pose_margin_m")
     OPTIONAL: ClassVar[frozenset[str]] = frozenset({"reasons", "progress", "safety", "tracking",
-                                                    *_TRACKING, "reanchored_s"})
+                                                    *_TRACKING, "reanchored_s", "pose_margin_m"})
     WALL_CLOCK: ClassVar[tuple[str, ...]] = ("plan_time_s", "motion_time_s", "progress",
                                              "late_plans", "safety_time_s")
 
@@ -136,6 +139,7 @@ class SequentialStats(StatsRecord):
     tracking_rms_m: float | None = None
     tracking_max_m: float | None = None
     reanchored_s: list[float] = field(default_factory=list)
+    pose_margin_m: float | None = None
 
 
 @dataclass
@@ -159,7 +163,7 @@ class SpaceTimeStats(SequentialStats):
         "statuses", "iterations", "late_plans", "plan_time_s", "motion_time_s", "replan_times_s",
         "waits", "fallbacks", "safety_time_s", "st_waits_s", "st_timed", "st_candidates",
         "st_pruned", "st_trapped", "inside_discs", "reasons", "progress", "safety", "tracking", *_TRACKING,
-        "reanchored_s")
+        "reanchored_s", "pose_margin_m")
     OPTIONAL: ClassVar[frozenset[str]] = SequentialStats.OPTIONAL | {"inside_discs"}
 
     st_waits_s: list[float] = field(default_factory=list)

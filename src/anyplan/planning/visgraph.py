@@ -28,7 +28,8 @@ from anyplan.planning.problem import Problem
 from anyplan.planning.status import PlannerStatus
 from anyplan.planning.termination import TerminationCondition
 
-__all__ = ["VisGraphResult", "shortest_path", "lower_bound", "VisGraphPlanner", "warm_up"]
+__all__ = ["VisGraphResult", "shortest_path", "lower_bound", "reachable_margin", "VisGraphPlanner",
+           "warm_up"]
 
 DEFAULT_ARC_STEP = 2.0 * math.pi / 64.0
 _EPS = 1e-9  # geometric tolerance [m] of the interior tests
@@ -332,6 +333,40 @@ def lower_bound(problem: Problem, arc_step: float = DEFAULT_ARC_STEP) -> float:
     if res.status in (PlannerStatus.INVALID_START, PlannerStatus.INVALID_GOAL):
         return math.inf
     return res.cost
+
+
+def reachable_margin(obstacles: ObstacleSet, start: np.ndarray | tuple[float, float],
+                     goal: np.ndarray | tuple[float, float], radius: float, most: float,
+                     tol: float = 0.005) -> float:
+    """The largest extra clearance ``m`` in [0, ``most``] [m] (to within ``tol``) with which a
+    disc of ``radius + m`` [m] still has a path from ``start`` to ``goal``: a valid path of the
+    ``feasible`` variant of :func:`shortest_path` (so ``m`` never exceeds the narrowest passage
+    the way needs, nor the start's and the goal's own clearance). ``most`` when the goal is
+    reachable with it, 0 when not even with ``tol``; bisection, at most about
+    ``log2(most / tol) + 2`` searches.
+
+    Examples:
+        Between two walls 1 m apart, a 0.3 m disc has 0.2 m to spare on each side:
+
+        >>> from anyplan.geometry.shapes import rectangle
+        >>> walls = ObstacleSet([rectangle((2.0, -0.5), (4.0, 1.0)), rectangle((2.0, 1.5), (4.0, 1.0))],
+        ...                     bounds=(-2.0, -1.0, 6.0, 2.0))
+        >>> round(reachable_margin(walls, (-1.0, 0.5), (5.0, 0.5), 0.3, 0.5), 2)
+        0.2
+    """
+    def ok(m: float) -> bool:
+        return bool(shortest_path(Problem.create(obstacles, start, goal, radius + m)).status)
+
+    if not most > 0.0 or ok(most):
+        return max(float(most), 0.0)
+    lo, hi = 0.0, float(most)
+    if not ok(min(tol, hi)):
+        return 0.0
+    lo = min(tol, hi)
+    while hi - lo > tol:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+    return lo
 
 
 def warm_up() -> None:
