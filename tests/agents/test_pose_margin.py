@@ -11,7 +11,7 @@ from anyplan.agents import make_agent
 from anyplan.agents.settings import deterministic_settings
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.shapes import rectangle
-from anyplan.planning.visgraph import reachable_margin
+from anyplan.planning.visgraph import reachable_margin, usable_margin
 from anyplan.simulation import SimConfig, simulate
 from anyplan.world import scenario_from_dict
 from tests.conftest import small_scenario_dict
@@ -47,13 +47,14 @@ def _around_a_box(width: float = 1.0):
     return scenario_from_dict(d)
 
 
-@pytest.mark.parametrize("planner", ["seq-bitstar", "st-bitstar"])
+@pytest.mark.parametrize("planner", ["seq-bitstar", "st-bitstar", "bitstar"])
 def test_the_robot_keeps_the_margin_from_the_static_obstacles(planner):
     sc = _around_a_box()
     cls = type(make_agent(planner))
     runs = {}
     for m in (0.0, 0.1):
-        agent = make_agent(planner, **deterministic_settings(cls, planner), pose_margin_m=m)
+        det = {} if planner == "bitstar" else deterministic_settings(cls, planner)  # one plan
+        agent = make_agent(planner, **det, pose_margin_m=m)
         runs[m] = simulate(sc, agent, seed=1, config=SimConfig())
         assert runs[m].status == "reached"
     bare, kept = runs[0.0], runs[0.1]
@@ -76,10 +77,22 @@ def test_a_narrow_way_halves_what_it_leaves():
     assert res.status == "reached"
 
 
+@pytest.mark.parametrize("planner", ["st-bitstar", "bitstar"])
 @pytest.mark.parametrize("value", [-0.1, float("nan"), float("inf"), "0.1"])
-def test_bad_pose_margins_are_refused(value):
+def test_bad_pose_margins_are_refused(planner, value):
     with pytest.raises(ValueError, match="pose_margin_m"):
-        make_agent("st-bitstar", pose_margin_m=value)
+        make_agent(planner, pose_margin_m=value)
+
+
+@pytest.mark.parametrize("width", [0.73, 0.83, 1.1])
+def test_usable_margin_is_what_is_asked_or_half_the_room(width):
+    walls, ends = _corridor(width), ((-1.0, 0.5), (5.0, 0.5))
+    room = reachable_margin(walls, *ends, 0.3, 1.0)
+    for wanted in (0.05, 0.1, 0.2):
+        got = usable_margin(walls, *ends, 0.3, wanted)
+        half = 0.5 * reachable_margin(walls, *ends, 0.3, wanted)
+        assert got == (wanted if room >= wanted else pytest.approx(half))
+        assert got <= min(wanted, room) + 1e-9
 
 
 def test_no_way_no_margin():

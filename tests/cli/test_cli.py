@@ -154,3 +154,7 @@ def test_a_localization_error_gets_its_own_row_and_its_summary_line(tmp_path, ca
     worst = extra["localization"]["max_position_error_m"]
     assert (f"localization   believed position off by {worst:.3f} m at most "
             "(spreads 0.05 m, 0.01 rad)") in lines
+    assert main(["run", "paper-1", "--out", str(tmp_path / "m"), "--no-plot", "--deterministic",
+                 "--localization-noise", "0.02,0.01", "--set", "pose_margin_m=0.05"]) == 0
+    (line,) = [ln for ln in capsys.readouterr().out.splitlines() if ln.strip().startswith("localization")]
+    assert line.endswith("; 0.050 m more clearance kept for it")

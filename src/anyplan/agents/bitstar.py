@@ -15,6 +15,7 @@ what lets the spline round the corners of BIT*'s path without cutting into an ob
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -41,6 +42,9 @@ class BITStarAgent(Agent):
         max_attempts: BIT* calls (each with twice the previous budget) before giving up.
         gains: Kanayama gains (defaults: :class:`~anyplan.control.KanayamaGains`).
         control_dt: Control period [s] assumed before the second observation reveals it.
+        pose_margin_m: Extra clearance [m] kept from the obstacles for the robot's localization
+            error, added to both margins as far as the way to the goal leaves room for it
+            (:func:`~anyplan.planning.visgraph.usable_margin`; as ``seq-bitstar``'s). 0: none.
     """
 
     name = "bitstar"
@@ -50,12 +54,16 @@ class BITStarAgent(Agent):
 
     def __init__(self, time_budget_s: float = 0.5, plan_margin: float = 0.03,
                  smooth_margin: float = 0.015, max_attempts: int = 3,
-                 gains: KanayamaGains | None = None, control_dt: float = 0.05) -> None:
+                 gains: KanayamaGains | None = None, control_dt: float = 0.05,
+                 pose_margin_m: float = 0.0) -> None:
         super().__init__()
         if not time_budget_s > 0.0:
             raise ValueError(f"time_budget_s must be > 0 s, got {time_budget_s}")
         if not 0.0 <= smooth_margin <= plan_margin:
             raise ValueError("smooth_margin must be in [0, plan_margin]")
+        if not (isinstance(pose_margin_m, int | float) and 0.0 <= pose_margin_m < math.inf):
+            raise ValueError(f"pose_margin_m: must be >= 0, got {pose_margin_m!r}")
+        self.pose_margin_m = float(pose_margin_m)
         if max_attempts < 1:
             raise ValueError(f"max_attempts must be >= 1, got {max_attempts}")
         self.time_budget_s = float(time_budget_s)
@@ -86,9 +94,17 @@ class BITStarAgent(Agent):
 
         spec, r = self.spec, obs.robot
         start = (r.x, r.y)
+        extra = 0.0
+        if self.pose_margin_m > 0.0:  # the localization margin the way to the goal leaves room for
+            from anyplan.planning.visgraph import usable_margin
+
+            extra = usable_margin(self.obstacles, start, spec.goal, spec.radius + self.plan_margin,
+                                  self.pose_margin_m)
+            self.record.pose_margin_m = extra
         # Keep the margin only where the start allows it (a start hugging an obstacle).
-        margin = min(self.plan_margin, max(self.obstacles.clearance(start) - spec.radius, 0.0))
-        smooth_margin = min(self.smooth_margin, margin)
+        margin = min(self.plan_margin + extra,
+                     max(self.obstacles.clearance(start) - spec.radius, 0.0))
+        smooth_margin = min(self.smooth_margin + extra, margin)
         t0 = time.perf_counter()
         budget = self.time_budget_s
         res = None

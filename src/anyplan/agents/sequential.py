@@ -27,7 +27,7 @@ from anyplan.agents.stats import SequentialStats
 from anyplan.agents.warmup import warm_up_kernels
 from anyplan.control.kanayama import KanayamaGains
 from anyplan.planning.sequential import SequentialBITStar, SequentialConfig, SequentialResult
-from anyplan.planning.visgraph import reachable_margin
+from anyplan.planning.visgraph import usable_margin
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
 from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.reference import ReferenceBuilder
@@ -48,7 +48,7 @@ class SequentialBITStarAgent(ReplanningAgent):
             localization error (2-3 standard deviations of its position, the spread its
             localizer reports): added to ``plan_margin`` and ``smooth_margin``, at reset
             reduced to what the way from the start to the goal allows
-            (:func:`~anyplan.planning.visgraph.reachable_margin`; the margin taken is
+            (:func:`~anyplan.planning.visgraph.usable_margin`; the margin taken is
             ``result.extra["pose_margin_m"]``). 0: none.
         check_period_s: How often [s] the current motion is checked against the predictions.
         min_replan_interval_s: Minimum time [s] between two replannings (unless the predicted
@@ -110,14 +110,10 @@ class SequentialBITStarAgent(ReplanningAgent):
         self.rng = rng
         self.predictor = ConstantTwistPredictor()
         spec = self.spec
-        # the localization margin the way to the goal leaves room for: where its narrowest
-        # passage allows less than asked for, half of what it allows (a passage left exactly
-        # as wide as the disc planned for is one BIT*'s samples hardly ever find)
-        extra = None
-        if self.pose_margin_m > 0.0:
-            extra = reachable_margin(self.obstacles, spec.start[:2], spec.goal,
-                                     spec.radius + self.plan_margin, self.pose_margin_m)
-            extra = extra if extra >= self.pose_margin_m else 0.5 * extra
+        # the localization margin, as far as the way to the goal leaves room for it
+        extra = (usable_margin(self.obstacles, spec.start[:2], spec.goal,
+                               spec.radius + self.plan_margin, self.pose_margin_m)
+                 if self.pose_margin_m > 0.0 else None)
         self.loop = SequentialBITStar(self.obstacles, robot_radius=spec.radius,
                                       plan_radius=spec.radius + self.plan_margin + (extra or 0.0),
                                       config=self.config, rng=rng)

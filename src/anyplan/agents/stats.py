@@ -194,12 +194,14 @@ class BITStarStats(StatsRecord):
         tracking_max_m: Largest such distance [m].
         tracking: The tracker's counts (``tracked`` perception; reported after the tracking
             error, since the motion starts in the first step).
+        pose_margin_m: The clearance [m] kept for the localization error (``pose_margin_m``,
+            as the way to the goal allows).
     """
 
     KEYS: ClassVar[tuple[str, ...]] = (
         "plan_status", "bitstar_time_s", "motion_time_s", "path_cost_m", "trajectory_kind",
         "trajectory_certified_free", "smoothed_length_m", "reference_duration_s",
-        "time_lower_bound_s", "smoothed_path", "progress", *_TRACKING, "tracking")
+        "time_lower_bound_s", "smoothed_path", "progress", *_TRACKING, "tracking", "pose_margin_m")
     OPTIONAL: ClassVar[frozenset[str]] = frozenset(KEYS)
     WALL_CLOCK: ClassVar[tuple[str, ...]] = ("bitstar_time_s", "motion_time_s", "progress")
 
@@ -216,6 +218,7 @@ class BITStarStats(StatsRecord):
     progress: list[list[float]] | None = None
     tracking_rms_m: float | None = None
     tracking_max_m: float | None = None
+    pose_margin_m: float | None = None
 
 
 @dataclass

@@ -192,10 +192,13 @@ def _tracking_line(extra: dict) -> str:
     return f"  tracking       {'-' if worst is None else f'{worst:.3f} m'} from the reference at most; {off}"
 
 
-def _localization_line(loc: dict) -> str:
-    """How far off the robot believed its position at most, with the error's spreads."""
+def _localization_line(extra: dict) -> str:
+    """How far off the robot believed its position at most, with the error's spreads, and the
+    clearance its planner kept for it (``pose_margin_m``)."""
+    loc, kept = extra["localization"], extra.get("pose_margin_m")
     return (f"  localization   believed position off by {loc['max_position_error_m']:.3f} m at most "
-            f"(spreads {loc['sigma_xy_m']:g} m, {loc['sigma_theta_rad']:g} rad)")
+            f"(spreads {loc['sigma_xy_m']:g} m, {loc['sigma_theta_rad']:g} rad)"
+            + ("" if kept is None else f"; {kept:.3f} m more clearance kept for it"))
 
 
 def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
@@ -221,7 +224,7 @@ def summary(result, out: Path) -> str:  # noqa: ANN001 - RunResult
           if result.extra.get("fallbacks") else []),
         *([_tracking_line(result.extra)] if any(result.extra.get(k) for k in (
             "actuation", "localization", "reanchored_s")) else []),
-        *([_localization_line(result.extra["localization"])]
+        *([_localization_line(result.extra)]
           if result.extra.get("localization") else []),
         f"  wrote          {out / 'result.json'}",
     ]

@@ -28,8 +28,8 @@ from anyplan.planning.problem import Problem
 from anyplan.planning.status import PlannerStatus
 from anyplan.planning.termination import TerminationCondition
 
-__all__ = ["VisGraphResult", "shortest_path", "lower_bound", "reachable_margin", "VisGraphPlanner",
-           "warm_up"]
+__all__ = ["VisGraphResult", "shortest_path", "lower_bound", "reachable_margin", "usable_margin",
+           "VisGraphPlanner", "warm_up"]
 
 DEFAULT_ARC_STEP = 2.0 * math.pi / 64.0
 _EPS = 1e-9  # geometric tolerance [m] of the interior tests
@@ -367,6 +367,17 @@ def reachable_margin(obstacles: ObstacleSet, start: np.ndarray | tuple[float, fl
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if ok(mid) else (lo, mid)
     return lo
+
+
+def usable_margin(obstacles: ObstacleSet, start: np.ndarray | tuple[float, float],
+                  goal: np.ndarray | tuple[float, float], radius: float, wanted: float) -> float:
+    """The extra clearance [m] a planner may keep beyond ``radius`` [m] on the way from
+    ``start`` to ``goal``: ``wanted`` when the way leaves room for it
+    (:func:`reachable_margin`), else half the room it leaves. A passage left exactly as wide as
+    the disc planned for is one a sampling planner hardly ever finds (its samples must fall on a
+    line); half the room keeps the other half free for them, and as much for the robot."""
+    room = reachable_margin(obstacles, start, goal, radius, wanted)
+    return room if room >= wanted else 0.5 * room
 
 
 def warm_up() -> None:
