@@ -104,3 +104,58 @@ def test_seq_bitstar_and_dovs_run_in_tracked_mode():
         res = simulate(sc, make_agent(name), seed=1, config=SimConfig(time_limit=30.0))
         assert res.reached_goal and not res.collision, name
         assert res.extra["perception"]["detections"] > 0
+
+
+class Mover(Spy):
+    """Drives a fixed command (an arc) and records what it is shown."""
+
+    def act(self, obs: Observation) -> Command:
+        super().act(obs)
+        return Command(0.4, 0.2)
+
+
+def _standing_person_speeds(odom: bool) -> np.ndarray:
+    """The estimated speed [m/s] of a person standing still, seen by a robot that drives an arc
+    with a 5 cm localization error, the tracks kept in the odometry frame or in the map's."""
+    from anyplan.simulation.simulator import Simulation
+
+    d = small_scenario_dict(static_obstacles=[])
+    d["dynamic_obstacles"] = [{"name": "P", "start": [5.0, 4.0, 0.0], "v": 0.0, "radius": 0.25}]
+    d["sensing"] = {"mode": "tracked", "noise_m": 0.01, "rate_hz": 10.0}
+    sc = scenario_from_dict(d)
+    sim = Simulation(sc, SimConfig(time_limit=12.0, localization_sigma_xy=0.05,
+                                   localization_sigma_theta=0.02), seed=4)
+    spy = Mover()
+    agent = TrackingAgent(spy, TrackerConfig(sigma_m=0.01))
+    agent.reset(sc.static_only(), np.random.default_rng(0))
+    while not sim.done:
+        obs = sim.observation()
+        if not odom:
+            obs = Observation(obs.t, obs.robot, obs.obstacles, obs.detections, None)
+        sim.step(agent.act(obs))
+    return np.array([o.v for ob in spy.log[40:] for o in ob.obstacles if o.name == "P"])
+
+
+def test_tracks_in_the_odometry_frame_do_not_take_the_localizers_wandering_for_motion():
+    in_odom, in_map = _standing_person_speeds(True), _standing_person_speeds(False)
+    assert len(in_odom) > 100 and len(in_map) == len(in_odom)
+    # in the map frame the wandering estimate moves the person about; odometry is smooth
+    assert np.median(in_odom) < np.median(in_map)
+    assert np.percentile(in_odom, 95) < 0.5 * np.percentile(in_map, 95)
+    assert np.percentile(in_odom, 95) < 0.2  # the tracker's own noise (1 cm detections at 10 Hz)
+
+
+def test_the_odometry_pose_is_the_true_pose_with_an_exact_drive():
+    from anyplan.simulation.simulator import Simulation
+
+    sc = scenario_from_dict(small_scenario_dict(static_obstacles=[]))
+    exact = Simulation(sc, SimConfig(time_limit=3.0), seed=1)
+    slip = Simulation(sc, SimConfig(time_limit=3.0, actuation_sigma_v=0.1,
+                                    actuation_sigma_omega=0.1), seed=1)
+    for _ in range(40):
+        for sim in (exact, slip):
+            assert sim.observation().odom == sim.odom
+            sim.step(Command(0.4, 0.3))
+        assert exact.odom == exact.state  # the same integration, bit for bit
+    # with an execution error odometry integrates the drive's twist, not the ground's: it drifts
+    assert 0.0 < np.hypot(slip.odom.x - slip.state.x, slip.odom.y - slip.state.y) < 0.5

@@ -40,12 +40,16 @@ class Observation:
             ``robot.sensing_range``), with pose and twist (``oracle`` and ``twist`` perception).
         detections: Noisy positions of the obstacles detected at this step (``tracked``
             perception, only on sensor frames; see :mod:`anyplan.simulation.perception`).
+        odom: The robot's odometry pose: its start moved by the twist its drive reports, step
+            by step (smooth, drifting with an execution error); the pose of ``robot`` is the
+            localizer's. None when not given.
     """
 
     t: float
     robot: RobotState
     obstacles: tuple[ObstacleObservation, ...] = ()
     detections: tuple[Detection, ...] = ()
+    odom: RobotState | None = None
 
 
 @dataclass

@@ -9,6 +9,13 @@ twist of the mean, no motion model) carrying the growth of their uncertain disc
 (:class:`~anyplan.prediction.uncertain.UncertaintyModel`). Every planner therefore plans against
 the same uncertain predictions, through its usual predictor.
 
+**The tracking frame.** Tracks are kept in the robot's odometry frame (``Observation.odom``)
+whenever its pose there differs from the localizer's (``Observation.robot``): a detection is
+moved from the believed pose to the odometry pose with the same offset in the robot's body, and
+the estimates are moved back. Odometry is smooth, the localizer's estimate wanders, and in the
+map frame a tracker would read that wandering as the obstacles' motion (as ROS stacks track in
+``odom``, not ``map``). With an exact localizer and drive the two frames are the same.
+
 **Leaving the tube.** The wrapper keeps the predictions the inner agent last planned against. A
 detection farther from its predicted centre than the extra radius capped at
 ``UncertaintyModel.tube_cap_m``, plus 3 noise standard deviations, has left the tube: the wrapper
@@ -19,13 +26,13 @@ is narrower than the planned disc: ``docs/perception.md``, "Leaving the tube".
 from __future__ import annotations
 
 import math
-from dataclasses import fields
+from dataclasses import fields, replace
 
 import numpy as np
 
 from anyplan.agents.base import Agent, AgentStats, Observation
 from anyplan.agents.stats import TrackerCounts
-from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
+from anyplan.prediction.base import ConstantTwistPredictor, ObstacleObservation, PredictedObstacle
 from anyplan.prediction.tracking import Tracker, TrackerConfig
 from anyplan.prediction.uncertain import UNCERTAINTY_SETTINGS, UncertaintyModel
 from anyplan.world.robot import Command
@@ -94,8 +101,17 @@ class TrackingAgent(Agent):
         return None
 
     def act(self, obs: Observation) -> Command:
-        self.tracker.update(obs.t, obs.detections)
+        r, o = obs.robot, obs.odom
+        believed = (r.x, r.y, r.theta)
+        odom = None if o is None or (o.x, o.y, o.theta) == believed else (o.x, o.y, o.theta)
+        dets = obs.detections
+        if odom is not None and dets:
+            q = _moved(np.array([[d.x, d.y] for d in dets]), believed, odom)
+            dets = tuple(replace(d, x=float(x), y=float(y)) for d, (x, y) in zip(dets, q, strict=True))
+        self.tracker.update(obs.t, dets)
         seen = self.uncertainty.observations(self.tracker.estimates(obs.t))
+        if odom is not None and seen:
+            seen = _to_frame(seen, odom, believed)
         left = self._check_tube(obs) if self._tube else None
         if left is not None:
             self.tube_exits += 1
@@ -116,3 +132,22 @@ class TrackingAgent(Agent):
         else:
             st.extra["tracking"] = counts
         return cmd
+
+
+def _moved(points: np.ndarray, src: tuple[float, float, float],
+           dst: tuple[float, float, float]) -> np.ndarray:
+    """Points (N, 2) [m] seen from pose ``src`` (x, y, heading) put at the same offsets in the
+    body of pose ``dst``."""
+    c, s = math.cos(dst[2] - src[2]), math.sin(dst[2] - src[2])
+    d = points - (src[0], src[1])
+    return np.column_stack([dst[0] + c * d[:, 0] - s * d[:, 1], dst[1] + s * d[:, 0] + c * d[:, 1]])
+
+
+def _to_frame(obs: tuple[ObstacleObservation, ...], src: tuple[float, float, float],
+              dst: tuple[float, float, float]) -> tuple[ObstacleObservation, ...]:
+    """Estimated obstacles kept in the frame of pose ``src`` as seen from pose ``dst`` (their
+    headings turned with it)."""
+    q = _moved(np.array([[o.x, o.y] for o in obs]), src, dst)
+    turn = dst[2] - src[2]
+    return tuple(replace(o, x=float(x), y=float(y), theta=o.theta + turn)
+                 for o, (x, y) in zip(obs, q, strict=True))

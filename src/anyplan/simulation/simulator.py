@@ -25,6 +25,7 @@ from anyplan.config import SettingError, setting, validate
 from anyplan.errors import UnknownNameError
 from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.geometry.moving import closest_approach_straight
+from anyplan.geometry.se2 import unicycle_arc, wrap_angle
 from anyplan.planning.time_bound import scenario_time_lower_bound
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.simulation.actuation import ActuationNoise
@@ -175,6 +176,9 @@ class Simulation:
         self._obstacles = scenario.obstacle_set()
         self._movers = scenario.moving_obstacles
         self.state = RobotState(*spec.start, 0.0, 0.0)
+        #: The odometry pose: the start moved by the drive's twist each step (the true pose
+        #: unless the robot has an execution error).
+        self.odom = self.state
         self.t = 0.0
         self.steps = 0
         self.trajectory: list[list[float]] = [[0.0, self.state.x, self.state.y, self.state.theta, 0.0, 0.0]]
@@ -241,9 +245,9 @@ class Simulation:
         seen, detections = self.sensor.observe(self.t, self.state)
         loc = self.localization
         if loc is None:
-            return Observation(self.t, self.state, seen, detections)
+            return Observation(self.t, self.state, seen, detections, self.odom)
         return Observation(self.t, loc.estimate(self.state), loc.observed(self.state, seen),
-                           loc.detected(self.state, detections))
+                           loc.detected(self.state, detections), self.odom)
 
     def step(self, cmd: Command) -> None:
         """Clip ``cmd`` to the robot's limits, integrate one step, move the obstacles, test the
@@ -260,6 +264,14 @@ class Simulation:
         state = self.state
         new = step(spec, state, cmd, dt) if self.actuation is None else self.actuation.step(
             spec, state, cmd, dt)
+        # odometry integrates the drive's twist as the exact step does (the same pose without an
+        # execution error)
+        od = self.odom
+        if self.actuation is None and od == state:
+            self.odom = new
+        else:
+            ox, oy, oth = unicycle_arc(od.x, od.y, od.theta, new.v, new.omega, dt)
+            self.odom = RobotState(ox, oy, float(wrap_angle(oth)), new.v, new.omega)
         t0, t_new = self.t, (self.steps + 1) * dt
         a = np.array([state.x, state.y])
         b = np.array([new.x, new.y])
