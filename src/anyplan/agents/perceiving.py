@@ -6,21 +6,12 @@ at every step it feeds the detections to an IMM tracker
 (:class:`~anyplan.prediction.tracking.Tracker`) and gives the inner agent an
 :class:`~anyplan.agents.base.Observation` whose obstacles are the tracks' estimates (pose and
 twist of the mean, no motion model) carrying the growth of their uncertain disc
-(:class:`~anyplan.prediction.uncertain.UncertaintyModel`). Every planner therefore plans against
-the same uncertain predictions, through its usual predictor.
-
-**The tracking frame.** Tracks are kept in the robot's odometry frame (``Observation.odom``)
-whenever its pose there differs from the localizer's (``Observation.robot``): a detection is
-moved from the believed pose to the odometry pose with the same offset in the robot's body, and
-the estimates are moved back. Odometry is smooth, the localizer's estimate wanders, and in the
-map frame a tracker would read that wandering as the obstacles' motion (as ROS stacks track in
-``odom``, not ``map``). With an exact localizer and drive the two frames are the same.
-
-**Leaving the tube.** The wrapper keeps the predictions the inner agent last planned against. A
-detection farther from its predicted centre than the extra radius capped at
-``UncertaintyModel.tube_cap_m``, plus 3 noise standard deviations, has left the tube: the wrapper
-asks the agent to replan (``request_replan(reason)``, if it has one) and counts it. Why the tube
-is narrower than the planned disc: ``docs/perception.md``, "Leaving the tube".
+(:class:`~anyplan.prediction.uncertain.UncertaintyModel`). Tracks are kept in the robot's
+odometry frame (``Observation.odom``) whenever the localizer's pose differs from it. A detection
+that leaves the tube of the prediction the agent last planned against (its extra radius capped at
+``UncertaintyModel.tube_cap_m``, plus 3 noise standard deviations) asks the agent to replan
+(``request_replan(reason)``). Both in ``docs/perception.md``, "The pipeline in ``tracked``
+mode".
 """
 
 from __future__ import annotations
