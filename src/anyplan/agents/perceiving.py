@@ -23,6 +23,7 @@ import numpy as np
 
 from anyplan.agents.base import Agent, AgentStats, Observation
 from anyplan.agents.stats import TrackerCounts
+from anyplan.geometry.se2 import carry
 from anyplan.prediction.base import ConstantTwistPredictor, ObstacleObservation, PredictedObstacle
 from anyplan.prediction.tracking import Tracker, TrackerConfig
 from anyplan.prediction.uncertain import UNCERTAINTY_SETTINGS, UncertaintyModel
@@ -129,9 +130,7 @@ def _moved(points: np.ndarray, src: tuple[float, float, float],
            dst: tuple[float, float, float]) -> np.ndarray:
     """Points (N, 2) [m] seen from pose ``src`` (x, y, heading) put at the same offsets in the
     body of pose ``dst``."""
-    c, s = math.cos(dst[2] - src[2]), math.sin(dst[2] - src[2])
-    d = points - (src[0], src[1])
-    return np.column_stack([dst[0] + c * d[:, 0] - s * d[:, 1], dst[1] + s * d[:, 0] + c * d[:, 1]])
+    return carry(points, src[:2], dst[:2], dst[2] - src[2])
 
 
 def _to_frame(obs: tuple[ObstacleObservation, ...], src: tuple[float, float, float],

@@ -205,8 +205,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         sys.stderr.write(f"anyplan: bench stopped: {exc}\n")
         return 1
     hashes = {sc.content_hash() for sc in scenarios}
-    configs = {(p.name, agent_settings_string(p.config, tracker, cfg.actuation, cfg.localization))
-               for p in planners}
+    configs = {(p.name, agent_settings_string(p.config, cfg)) for p in planners}
     with ResultsDB(db_path, readonly=True) as db:
         runs = [r for r in db.runs()
                 if r["scenario_hash"] in hashes and str(r["experiment_seed"]) == str(args.seed)

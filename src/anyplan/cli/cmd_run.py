@@ -159,7 +159,7 @@ def _run(args: argparse.Namespace) -> int:
     result = simulate(scenario, agent, seed=args.seed, config=cfg)
     # the settings given (--set, --deterministic, --tracker), as anyplan bench records them: with
     # the seed and the scenario, what reproduces the run
-    result.extra["settings"] = agent_settings_string(config, cfg.tracker, cfg.actuation, cfg.localization)
+    result.extra["settings"] = agent_settings_string(config, cfg)
     (out / "result.json").write_text(json.dumps(result.to_dict(), indent=1))
     if not args.no_plot:
         from anyplan.viz.run import save_run_figure

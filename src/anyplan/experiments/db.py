@@ -18,7 +18,7 @@ import math
 import platform
 import sqlite3
 import zlib
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
@@ -89,25 +89,31 @@ def settings_string(config: Mapping[str, Any]) -> str:
     return "".join(f"{k} = {json.dumps(config[k], sort_keys=True)};" for k in sorted(config))
 
 
-def agent_settings_string(config: Mapping[str, Any], tracker: Sequence[tuple[str, float]] = (),
-                          actuation: tuple[float, float] = (0.0, 0.0),
-                          localization: tuple[float, float] = (0.0, 0.0)) -> str:
-    """The settings string of a benchmarked agent: its planner's (:func:`settings_string`), then
-    its tracker's (``SimConfig.tracker``, ``anyplan bench --tracker``) as ``tracker.NAME = VALUE;``
-    in name order, then the robot's execution error when there is one (``SimConfig``'s
-    ``actuation_sigma_v``, ``actuation_sigma_omega``; ``--actuation-noise``) as
+#: The robot's errors a settings string names, as (prefix, ``SimConfig`` property, the names of
+#: its two spreads): ``--actuation-noise`` and ``--localization-noise``.
+_ERRORS = (("actuation", "actuation", ("sigma_v", "sigma_omega")),
+           ("localization", "localization", ("sigma_xy", "sigma_theta")))
+
+
+def agent_settings_string(config: Mapping[str, Any], sim: Any = None) -> str:
+    """The settings string of a benchmarked agent: its planner's (:func:`settings_string`), then,
+    from the simulation settings ``sim`` (a :class:`~anyplan.simulation.SimConfig`; None: none),
+    its tracker's (``SimConfig.tracker``, ``anyplan bench --tracker``) as
+    ``tracker.NAME = VALUE;`` in name order, then the robot's execution error when there is one
+    (``SimConfig.actuation``; ``--actuation-noise``) as
     ``actuation.sigma_v = V;actuation.sigma_omega = W;``, then its localization error when there
-    is one (``localization_sigma_xy``, ``localization_sigma_theta``; ``--localization-noise``)
-    as ``localization.sigma_xy = S;localization.sigma_theta = T;``: runs with other tracker
+    is one (``SimConfig.localization``; ``--localization-noise``) as
+    ``localization.sigma_xy = S;localization.sigma_theta = T;``: runs with other tracker
     settings or another execution or localization error are another planner row."""
-    out = settings_string(config) + "".join(
-        f"tracker.{k} = {json.dumps(float(v))};" for k, v in sorted(tracker))
-    if any(float(a) != 0.0 for a in actuation):
-        out += (f"actuation.sigma_v = {json.dumps(float(actuation[0]))};"
-                f"actuation.sigma_omega = {json.dumps(float(actuation[1]))};")
-    if any(float(a) != 0.0 for a in localization):
-        out += (f"localization.sigma_xy = {json.dumps(float(localization[0]))};"
-                f"localization.sigma_theta = {json.dumps(float(localization[1]))};")
+    out = settings_string(config)
+    if sim is None:
+        return out
+    out += "".join(f"tracker.{k} = {json.dumps(float(v))};" for k, v in sorted(sim.tracker))
+    for prefix, prop, names in _ERRORS:
+        spreads = getattr(sim, prop)
+        if any(float(a) != 0.0 for a in spreads):
+            out += "".join(f"{prefix}.{n} = {json.dumps(float(a))};"
+                           for n, a in zip(names, spreads, strict=True))
     return out
 
 

@@ -329,8 +329,7 @@ def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], ru
         # the tracker's settings, the execution and localization errors (the same for every task) are part of
         # each planner's row
         plan_ids = {(p.name, settings_string(p.config)): db.planner_id(
-            p.name, agent_settings_string(p.config, sim.tracker, sim.actuation,
-                                           sim.localization)) for p in planners}
+            p.name, agent_settings_string(p.config, sim)) for p in planners}
         done = db.done_keys()
         tasks = []
         for t in all_tasks:

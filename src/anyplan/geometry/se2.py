@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-__all__ = ["wrap_angle", "unicycle_arc"]
+__all__ = ["wrap_angle", "unicycle_arc", "carry"]
 
 
 def wrap_angle(a: float | np.ndarray) -> float | np.ndarray:
@@ -39,3 +39,18 @@ def unicycle_arc(x: float, y: float, theta: float, v: float, omega: float,
     if xs.ndim == 0:
         return float(xs), float(ys), float(th)
     return xs, ys, th
+
+
+def carry(points: np.ndarray, src: tuple[float, float], dst: tuple[float, float],
+          turn: float) -> np.ndarray:
+    """Points (N, 2) [m] at their offsets from ``src`` (x, y) [m], placed at the same offsets
+    from ``dst``, turned by ``turn`` [rad]: what a robot at one pose sees, as a robot that
+    believes it is at another (``turn`` = the heading difference) places it.
+
+    Examples:
+        >>> carry(np.array([[2.0, 0.0]]), (1.0, 0.0), (0.0, 0.0), math.pi / 2).round(6).tolist()
+        [[0.0, 1.0]]
+    """
+    c, s = math.cos(turn), math.sin(turn)
+    d = np.asarray(points, dtype=float).reshape(-1, 2) - (src[0], src[1])
+    return np.column_stack([dst[0] + c * d[:, 0] - s * d[:, 1], dst[1] + s * d[:, 0] + c * d[:, 1]])

@@ -19,7 +19,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from anyplan.geometry.se2 import wrap_angle
+from anyplan.geometry.se2 import carry, wrap_angle
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.prediction.detection import Detection
 from anyplan.world.robot import RobotState
@@ -91,10 +91,8 @@ class LocalizationError:
     def to_map(self, state: RobotState, points: np.ndarray) -> np.ndarray:
         """Where points (N, 2) [m] that the robot at ``state`` senses land in its map: the same
         offset from the believed pose, turned by the heading error."""
-        c, s = math.cos(self.error[2]), math.sin(self.error[2])
-        d = np.asarray(points, dtype=float).reshape(-1, 2) - (state.x, state.y)
         est = self.estimate(state)
-        return np.column_stack([est.x + c * d[:, 0] - s * d[:, 1], est.y + s * d[:, 0] + c * d[:, 1]])
+        return carry(points, (state.x, state.y), (est.x, est.y), float(self.error[2]))
 
     def observed(self, state: RobotState, obs: tuple[ObstacleObservation, ...]
                  ) -> tuple[ObstacleObservation, ...]:
