@@ -241,3 +241,32 @@ def test_one_second_budget_within_five_percent_on_random_worlds():
         res = planner.result()
         assert res.status and p.path_valid(res.path)
         assert lb - 1e-9 <= res.cost <= 1.05 * lb
+
+
+def test_a_new_batch_queues_exactly_the_vertices_a_new_sample_comes_near():
+    """A batch queues the tree's vertices whose g + h_hat beats the solution and that were never
+    expanded or have one of the batch's new samples within r (other vertices saw every older
+    sample): the planner asks the new samples' grid about each vertex; brute force here."""
+    p = peers_problem(0.25)
+    queued = skipped = 0
+    for seed in (0, 1):
+        planner = bit(p, seed)
+        for n in range(1, 9):
+            planner.solve(batches(1) if n > 1 else first_solution())
+            planner._new_batch()  # the batch's start, as the search makes it
+            pts, tree, b = planner._points, planner._tree, planner._batch
+            q = planner._queue
+            m = int(pts.n[0])
+            new = np.asarray(b.new)
+            expect = set()
+            for i in np.flatnonzero(tree.vertex[:m]):
+                if tree.g[i] + pts.h_hat[i] >= planner.best_cost:
+                    continue
+                d = np.hypot(*(pts.xy[new] - pts.xy[i]).T)
+                if tree.expanded[i] < 0 or b.k > 0 or np.any((d <= b.radius) & (new != i)):
+                    expect.add(int(i))
+            got = set(q.vertex[: q.nv[0]].tolist())
+            assert got == expect
+            queued += len(expect)
+            skipped += int(tree.vertex[:m].sum()) - len(expect)
+    assert queued > 0 and skipped > 0  # both kinds of vertex occur

@@ -473,3 +473,37 @@ def test_straight_discs_in_closed_form_agree_with_the_certified_search(seed):
             first = first_collision(m, obs, 0.3, margin=0.05, sample_dt=sd)
             assert first is not None and first.t == min(h.t for h in new.values())
     assert found >= 10
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_robot_not_sampled_after_every_prediction_has_ended(seed):
+    # Every prediction straight with a horizon: the robot's samples stop at the first at or
+    # after the last horizon, the same times and positions as the whole motion's first ones,
+    # and the contacts are those on the whole motion's samples, bit for bit.
+    from anyplan.prediction import collision
+    from anyplan.prediction._contact_kernels import StraightDiscs
+
+    rng = np.random.default_rng(seed)
+    obs = []
+    for i in range(30):
+        x0, y0, th, v = rng.uniform((0, 2, -np.pi, 0.0), (9, 8, np.pi, 1.5))  # near its start
+        m = UnicycleMotion(x0, y0, th, v, 0.0, float(rng.uniform(0, 3)))
+        obs.append(PredictedObstacle(f"o{i}", 0.3, m, until=float(rng.uniform(1.0, 6.0))))
+    last = max(o.until for o in obs)
+    lines = StraightDiscs.of(obs)
+    found = 0
+    for m in MOTIONS.values():
+        assert m.t_end > last + 1.0  # the stop leaves samples out
+        for sd in (0.02, 0.05):
+            whole = SampledMotion(m, m.t_start, m.t_end, sd)
+            cut = SampledMotion(m, m.t_start, m.t_end, sd, stop=last)
+            k = len(cut._t)
+            assert k < len(whole._t) and cut._t[-1] >= last > cut._t[-2]
+            assert np.array_equal(cut._t, whole._t[:k]) and np.array_equal(cut._x, whole._x[:k])
+            ref = lines.first_contacts(whole._t, whole._x, whole._y, 0.35 + whole.error_bound,
+                                       m.t_start, m.t_end, False)
+            collision._MEMO.clear()
+            hits = {h.obstacle: h.t for h in predict_collisions(m, obs, 0.3, margin=0.05, sample_dt=sd)}
+            assert hits == {obs[int(j)].name: float(ref[j]) for j in np.flatnonzero(ref < np.inf)}
+            found += len(hits)
+    assert found >= 5

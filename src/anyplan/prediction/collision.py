@@ -69,11 +69,16 @@ class SampledMotion:
         motion: The motion to sample.
         t0, t1: Interval [s] to cover; outside it positions are clamped.
         dt: Sample spacing [s].
+        stop: Only the samples up to the first at or after ``stop`` [s] are made (the same
+            times as without it): nothing after ``stop`` is asked (every prediction has ended).
     """
 
-    def __init__(self, motion: TimedMotion, t0: float, t1: float, dt: float = 0.02) -> None:
+    def __init__(self, motion: TimedMotion, t0: float, t1: float, dt: float = 0.02,
+                 stop: float = math.inf) -> None:
         n = max(2, int(math.ceil((t1 - t0) / dt)) + 1)
         self._t = np.linspace(t0, t0 + (n - 1) * dt, n)
+        if stop < self._t[-2]:
+            self._t = self._t[:max(2, int(np.searchsorted(self._t, stop, side="left")) + 1)]
         p = motion.positions(self._t)
         self._x = np.ascontiguousarray(p[:, 0])
         self._y = np.ascontiguousarray(p[:, 1])
@@ -200,7 +205,9 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
     if not len(lines.index):
         return _certified_hits(motion, obstacles, robot_radius, t0, t1, margin, tol, sample_dt,
                                first_only)
-    sampled = SampledMotion(motion, t0, t1, sample_dt)
+    # every obstacle straight: the robot is not sampled after the last prediction's end
+    stop = float(lines.until.max()) if not lines.rest else math.inf
+    sampled = SampledMotion(motion, t0, t1, sample_dt, stop)
     out = _straight_hits(motion, sampled, obstacles, lines, robot_radius + margin, t0, t1,
                          first_only)
     if lines.rest:  # each obstacle's contact is its own: the same answer with or without the others

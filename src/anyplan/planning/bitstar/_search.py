@@ -233,26 +233,22 @@ def start_batch(p: Points, t: Tree, q: SearchQueue, b: Batch, pr: np.ndarray) ->
 
     A vertex expanded in an earlier batch only needs expanding again if a new sample lies
     within r of it (its expansion considers new samples only); skipping the others changes
-    nothing but the cost.
+    nothing but the cost. That test asks the new samples' grid about each such vertex (the
+    distance is symmetric, so it finds what asking all points about each new sample finds):
+    a search whose tree stays small while its samples pile up (a start boxed in by squares,
+    40 batches of 400) pays for its few vertices, not for every new sample's neighbours.
     """
     q.ne[0] = 0
     n = p.n[0]
-    near_new = np.zeros(n, np.bool_)
-    if b.k > 0:
-        near_new[:] = True
-    else:
-        near = np.empty(n, np.int64)
-        near_d = np.empty(n)
-        for i in range(b.new.shape[0]):
-            m = _graph.near(b.new[i], p, b, b.radius, b.start, b.items, near, near_d)
-            for u in range(m):
-                near_new[near[u]] = True
+    near = np.empty(b.new.shape[0], np.int64)  # scratch: a vertex's new neighbours
+    near_d = np.empty(b.new.shape[0])
     vs = np.int64(0)  # not a literal: one specialisation of push_vertex
     c_best = pr[0].best
     for i in range(n):
         if t.vertex[i]:
             t.old[i] = True
             key = t.g[i] + p.h_hat[i]
-            if key < c_best and (near_new[i] or t.expanded[i] < 0):
+            if key < c_best and (t.expanded[i] < 0 or b.k > 0 or _graph.near(
+                    i, p, b, b.radius, b.new_start, b.new_items, near, near_d) > 0):
                 vs = _queue.push_vertex(q.vkey, q.vertex, vs, key, i)
     q.nv[0] = vs
