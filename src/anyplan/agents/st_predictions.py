@@ -6,8 +6,9 @@ against in full, announced motions up to ``announced_horizon_s`` ahead. Uncertai
 radius is capped at ``plan_extra_m``, on a receding horizon, while the safety guard checks the
 full growth of the obstacles the robot does not outrun (``_outruns``; ``docs/perception.md``,
 "st-bitstar when the future is unknown"). When one planned disc holds every place the robot
-can reach, no search is made (``_trapped``).
-:class:`PlanningPredictions` is the agent's part that makes these views.
+can reach, no search is made (``_trapped``). What the predictions are also sets the check
+period in force (``_period``) and, while some future is extrapolated, the cap on the loop's
+paths (``_loop_cap``). :class:`PlanningPredictions` is the agent's part that makes these views.
 """
 
 from __future__ import annotations
@@ -42,6 +43,10 @@ class PlanningPredictions:
     plan_extra_m: float | None
     outrun_margin_mps: float | None
     announced_horizon_s: float | None
+    extrapolated_iterations: int | None
+    twist_check_period_s: float | None
+    check_period_s: float
+    _exact_twists: bool
     #: :meth:`_capped`'s answers for the latest predictions: (cap [m], {id of a prediction:
     #: (it, its capped disc)}).
     _capped_memo: tuple[float, dict[int, tuple[PredictedObstacle, PredictedObstacle]]] | None = None
@@ -179,3 +184,25 @@ class PlanningPredictions:
                           reach_cap_m=to_goal - spec.arrival_radius)
         self.record.st_trapped += trap is not None
         return trap is not None
+
+    def _note_predictions(self, preds: list[PredictedObstacle]) -> None:
+        """Whether the obstacles in view are predicted from exact twists (``twist``: their
+        predictions end, without uncertain discs), from the latest step that observed any."""
+        if preds:
+            self._exact_twists = all(o.until < math.inf and o.growth is None for o in preds)
+
+    def _period(self) -> float:
+        """The check period in force [s]: ``twist_check_period_s`` while the obstacles in view
+        are predicted from exact twists, else ``check_period_s``."""
+        if self._exact_twists and self.twist_check_period_s is not None:
+            return self.twist_check_period_s
+        return self.check_period_s
+
+    def _loop_cap(self, observed: list[PredictedObstacle]) -> int | None:
+        """The cap on the loop's paths in this replanning: ``extrapolated_iterations`` while an
+        obstacle in view has no announced motion (its prediction ends: ``twist``, ``tracked``),
+        else None (the loop's own ``max_iterations``). A deep search for detours threads paths
+        between guesses; measured, it bought nothing there (``docs/perception.md``)."""
+        if any(o.until < math.inf for o in observed):
+            return self.extrapolated_iterations
+        return None
