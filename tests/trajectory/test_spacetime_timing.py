@@ -285,3 +285,21 @@ def test_cached_rows_are_bit_for_bit_the_rows_sampled_one_obstacle_at_a_time():
             assert qx[k].tobytes() == q[:, 0].tobytes() and qy[k].tobytes() == q[:, 1].tobytes()
             assert r[k].tobytes() == want.tobytes()
             assert radii_at(o, t_mid).tobytes() == rm.tobytes()
+
+
+def test_rows_after_every_predictions_end_are_free_and_the_rest_as_computed_in_full():
+    # Predictions with horizons (until): the map computes its rows up to the last end only.
+    # A far obstacle that never ends makes it compute every row: the same map, bit for bit.
+    rng = np.random.default_rng(3)
+    obs = [PredictedObstacle(f"o{i}", 0.3, UnicycleMotion(float(rng.uniform(3, 7)), -1.0,
+                                                          np.pi / 2, float(rng.uniform(0.2, 0.6))),
+                             until=float(rng.uniform(2.0, 12.0))) for i in range(6)]
+    far = PredictedObstacle("F", 0.3, UnicycleMotion(5.0, 40.0, 0.0, 0.3))
+    last = max(o.until for o in obs)
+    for rows in (None, RowCache(1.0, 0.05)):
+        cut = build_stmap(_pts, 8.0, obs, SPEC.radius, 1.25, 25.0, margin=0.05, rows=rows)
+        full = build_stmap(_pts, 8.0, [*obs, far], SPEC.radius, 1.25, 25.0, margin=0.05,
+                           rows=None if rows is None else RowCache(1.0, 0.05))
+        assert np.array_equal(cut.forbidden, full.forbidden) and cut.forbidden.any()
+        starts = cut.t_map + cut.h * np.arange(cut.forbidden.shape[0])
+        assert not cut.forbidden[starts > last].any() and (starts > last).sum() > 100

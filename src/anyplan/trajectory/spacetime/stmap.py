@@ -307,11 +307,14 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     blockers: list[str] = []
     if not obstacles:
         return STMap(out, t_map, h, ds, length, blockers)
+    # Rows that start after every prediction's end hold no disc: they stay free, uncomputed.
+    ends = max(float(getattr(o, "until", math.inf)) for o in obstacles)
+    nfill = nrow if ends == math.inf else max(1, min(nrow, int(math.floor((ends - t_map) / h)) + 2))
     if rows is not None:
-        qx, qy, r_max = rows.rows_all(obstacles, j_first, j_first + nrow)
+        qx, qy, r_max = rows.rows_all(obstacles, j_first, j_first + nfill)
     else:
-        t_edges = t_map + h * np.arange(nrow + 1)
-        t_mid = t_map + h * (np.arange(nrow) + 0.5)
+        t_edges = t_map + h * np.arange(nfill + 1)
+        t_mid = t_map + h * (np.arange(nfill) + 0.5)
         q = np.stack([np.asarray(o.positions(t_mid), dtype=float).reshape(-1, 2) for o in obstacles])
         qx, qy = q[:, :, 0], q[:, :, 1]
         r_edges = np.stack([radii_at(o, t_edges) for o in obstacles])
@@ -323,7 +326,7 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     away = np.min(np.hypot(qx - gx, qy - gy) - grad - reach, axis=1) > 0.0  # never near the path
     near = np.flatnonzero(~away)
     if len(near):
-        hit = _fill(out, px, py, cx, cy, crad, np.ascontiguousarray(qx[near]),
+        hit = _fill(out[:nfill], px, py, cx, cy, crad, np.ascontiguousarray(qx[near]),
                     np.ascontiguousarray(qy[near]), np.ascontiguousarray(reach[near]),
                     speed[near] * h, _CHUNK, n_free, sx, sy, srad, _GROUP)
         blockers = [str(obstacles[k].name) for k, hh in zip(near, hit, strict=True) if hh]
