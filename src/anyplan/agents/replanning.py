@@ -23,7 +23,7 @@ from typing import Any
 from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
 from anyplan.agents.stats import SequentialStats
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
-from anyplan.geometry.se2 import unicycle_arc, wrap_angle
+from anyplan.geometry.se2 import wrap_angle
 from anyplan.prediction.base import ConstantTwistPredictor, PredictedObstacle
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.robot import Command, RobotSpec, RobotState
@@ -120,8 +120,7 @@ class ReplanningAgent(Agent):
         if self.trajectory is None:
             return RobotState(r.x, r.y, r.theta, 0.0, 0.0)
         if self._off_reference:
-            x, y, th = unicycle_arc(r.x, r.y, r.theta, r.v, r.omega, max(t - obs.t, 0.0))
-            return RobotState(x, y, float(wrap_angle(th)), r.v, r.omega)
+            return r.moved(r.v, r.omega, max(t - obs.t, 0.0))
         return self.trajectory.state(t)
 
     def _note_tracking(self, obs: Observation, traj: Trajectory) -> None:

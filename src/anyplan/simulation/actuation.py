@@ -1,26 +1,23 @@
 """Imperfect execution: the robot does not drive exactly the twist it achieves on paper.
 
-A real base slips, its wheels see uneven ground and its odometry does not see that, so the
-robot moves by a twist that differs from the one its drive achieves, by an error that persists
-over fractions of a second and grows with the motion. :class:`ActuationNoise` moves the pose by
-the achieved (clipped) twist plus a first-order Gauss-Markov error per axis (correlation time
-``tau_s``; Maybeck, *Stochastic Models, Estimation and Control*, vol. 1, 1979, section 4.11)
-whose spreads, ``sigma_v`` [m/s] and ``sigma_omega`` [rad/s] at full speed or turn rate, scale
-with ``min(1, |v| / v_max + |omega| / omega_max)``: a robot at rest does not drift (the error
-grows with the motion, as in the velocity motion model of Thrun, Burgard & Fox, *Probabilistic
-Robotics*, 2005, section 5.3). The twist stays within ``v_max`` and ``omega_max`` (at full
-speed the error can only slow the robot). The state reports the drive's twist (what odometry
-measures); the agent sees the pose the robot really reached. Seeded per run, on a stream of its
-own.
+A real base slips, its wheels see uneven ground and its odometry does not see that, so the robot
+moves by a twist that differs from the one its drive achieves, by an error that persists over
+fractions of a second and grows with the motion. :class:`ActuationNoise` moves the pose by the
+achieved (clipped) twist plus a first-order Gauss-Markov error per axis (correlation time
+``tau_s``; :class:`~anyplan.simulation.gauss_markov.GaussMarkov`) whose spreads, ``sigma_v``
+[m/s] and ``sigma_omega`` [rad/s] at full speed or turn rate, scale with ``min(1, |v| / v_max +
+|omega| / omega_max)``: a robot at rest does not drift (the error grows with the motion, as in
+the velocity motion model of Thrun, Burgard & Fox, *Probabilistic Robotics*, 2005, section 5.3).
+The twist stays within ``v_max`` and ``omega_max`` (at full speed the error can only slow the
+robot). The state reports the drive's twist (what odometry measures); the agent sees the pose
+the robot really reached. Seeded per run, on a stream of its own.
 """
 
 from __future__ import annotations
 
-import math
+from dataclasses import replace
 
-import numpy as np
-
-from anyplan.geometry.se2 import unicycle_arc, wrap_angle
+from anyplan.simulation.gauss_markov import GaussMarkov
 from anyplan.world.robot import Command, RobotSpec, RobotState, clip_command
 
 __all__ = ["ACTUATION_STREAM", "ACTUATION_TAU_S", "ActuationNoise"]
@@ -33,7 +30,7 @@ ACTUATION_STREAM = 0xAC7
 ACTUATION_TAU_S = 0.5
 
 
-class ActuationNoise:
+class ActuationNoise(GaussMarkov):
     """The execution error of one run.
 
     Args:
@@ -59,17 +56,9 @@ class ActuationNoise:
 
     def __init__(self, sigma_v: float, sigma_omega: float, seed: int,
                  tau_s: float = ACTUATION_TAU_S) -> None:
-        for name, val in (("sigma_v", sigma_v), ("sigma_omega", sigma_omega)):
-            if not (math.isfinite(val) and val >= 0.0):
-                raise ValueError(f"{name}: must be >= 0, got {val!r}")
-        if not (math.isfinite(tau_s) and tau_s > 0.0):
-            raise ValueError(f"tau_s: must be > 0, got {tau_s!r}")
-        self.sigma = np.array([float(sigma_v), float(sigma_omega)])
-        self.tau_s = float(tau_s)
-        self.seed_sequence = (int(seed), ACTUATION_STREAM)
-        self.rng = np.random.default_rng(list(self.seed_sequence))
         # the stationary state: the first step's error is drawn from the process's own spread
-        self.error = self.sigma * self.rng.standard_normal(2)
+        super().__init__(("sigma_v", "sigma_omega"), (sigma_v, sigma_omega), seed, ACTUATION_STREAM,
+                         tau_s)
         #: The twist the robot moved by in the last step (the drive's plus the error).
         self.ground = Command(0.0, 0.0)
 
@@ -83,12 +72,10 @@ class ActuationNoise:
         (:func:`~anyplan.world.robot.clip_command`), the pose moves by that twist plus this
         step's error scaled by the motion, held within ``v_max`` and ``omega_max`` (the
         unicycle integrated exactly), and the state reports the drive's twist."""
-        rho = math.exp(-dt / self.tau_s)
-        self.error = rho * self.error + math.sqrt(1.0 - rho * rho) * self.sigma * self.rng.standard_normal(2)
+        self.advance(dt)
         c = clip_command(spec, state, cmd, dt)
         scale = min(1.0, abs(c.v) / spec.v_max + abs(c.omega) / spec.omega_max)
         v = min(max(c.v + scale * float(self.error[0]), -spec.v_max), spec.v_max)
         w = min(max(c.omega + scale * float(self.error[1]), -spec.omega_max), spec.omega_max)
         self.ground = Command(v, w)
-        x, y, th = unicycle_arc(state.x, state.y, state.theta, v, w, dt)
-        return RobotState(x, y, float(wrap_angle(th)), c.v, c.omega)
+        return replace(state.moved(v, w, dt), v=c.v, omega=c.omega)

@@ -2,8 +2,8 @@
 
 A robot knows its pose from a localizer (scan matching against the map, AMCL), whose estimate
 is off by an error that wanders slowly: :class:`LocalizationError` draws it as a first-order
-Gauss-Markov process per axis (x, y [m], heading [rad]; correlation time ``tau_s``; Maybeck,
-*Stochastic Models, Estimation and Control*, vol. 1, 1979, section 4.11). The agent gets the
+Gauss-Markov process per axis (x, y [m], heading [rad]; correlation time ``tau_s``;
+:class:`~anyplan.simulation.gauss_markov.GaussMarkov`). The agent gets the
 estimated pose (its twist stays the drive's, as odometry measures it), so it plans and tracks
 in the map from where it believes it is; the simulator moves and tests the true robot. What the
 robot's own sensor sees is seen relative to the robot, and so lands in the map where the
@@ -22,6 +22,7 @@ import numpy as np
 from anyplan.geometry.se2 import carry, wrap_angle
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.prediction.detection import Detection
+from anyplan.simulation.gauss_markov import GaussMarkov
 from anyplan.world.robot import RobotState
 
 __all__ = ["LOCALIZATION_STREAM", "LOCALIZATION_TAU_S", "LocalizationError"]
@@ -33,7 +34,7 @@ LOCALIZATION_STREAM = 0x10C
 LOCALIZATION_TAU_S = 5.0
 
 
-class LocalizationError:
+class LocalizationError(GaussMarkov):
     """The localization error of one run.
 
     Args:
@@ -56,17 +57,9 @@ class LocalizationError:
 
     def __init__(self, sigma_xy: float, sigma_theta: float, seed: int,
                  tau_s: float = LOCALIZATION_TAU_S) -> None:
-        for name, val in (("sigma_xy", sigma_xy), ("sigma_theta", sigma_theta)):
-            if not (math.isfinite(val) and val >= 0.0):
-                raise ValueError(f"{name}: must be >= 0, got {val!r}")
-        if not (math.isfinite(tau_s) and tau_s > 0.0):
-            raise ValueError(f"tau_s: must be > 0, got {tau_s!r}")
-        self.sigma = np.array([float(sigma_xy), float(sigma_xy), float(sigma_theta)])
-        self.tau_s = float(tau_s)
-        self.seed_sequence = (int(seed), LOCALIZATION_STREAM)
-        self.rng = np.random.default_rng(list(self.seed_sequence))
-        #: The current error (x [m], y [m], heading [rad]), drawn from the stationary spread.
-        self.error = self.sigma * self.rng.standard_normal(3)
+        # the current error: x [m], y [m], heading [rad], drawn from the stationary spread
+        super().__init__(("sigma_xy", "sigma_xy", "sigma_theta"), (sigma_xy, sigma_xy, sigma_theta),
+                         seed, LOCALIZATION_STREAM, tau_s)
         #: The largest position error [m] so far.
         self.max_position_error_m = float(math.hypot(*self.error[:2]))
 
@@ -78,8 +71,7 @@ class LocalizationError:
 
     def step(self, dt: float) -> None:
         """Advance the error by ``dt`` [s]."""
-        rho = math.exp(-dt / self.tau_s)
-        self.error = rho * self.error + math.sqrt(1.0 - rho * rho) * self.sigma * self.rng.standard_normal(3)
+        self.advance(dt)
         self.max_position_error_m = max(self.max_position_error_m, float(math.hypot(*self.error[:2])))
 
     def estimate(self, state: RobotState) -> RobotState:

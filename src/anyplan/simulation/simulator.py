@@ -25,7 +25,6 @@ from anyplan.config import SettingError, setting, validate
 from anyplan.errors import UnknownNameError
 from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.geometry.moving import closest_approach_straight
-from anyplan.geometry.se2 import unicycle_arc, wrap_angle
 from anyplan.planning.time_bound import scenario_time_lower_bound
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.simulation.actuation import ActuationNoise
@@ -264,14 +263,9 @@ class Simulation:
         state = self.state
         new = step(spec, state, cmd, dt) if self.actuation is None else self.actuation.step(
             spec, state, cmd, dt)
-        # odometry integrates the drive's twist as the exact step does (the same pose without an
-        # execution error)
-        od = self.odom
-        if self.actuation is None and od == state:
-            self.odom = new
-        else:
-            ox, oy, oth = unicycle_arc(od.x, od.y, od.theta, new.v, new.omega, dt)
-            self.odom = RobotState(ox, oy, float(wrap_angle(oth)), new.v, new.omega)
+        # odometry integrates the drive's twist as the exact step does (the same pose, bit for
+        # bit, without an execution error)
+        self.odom = self.odom.moved(new.v, new.omega, dt)
         t0, t_new = self.t, (self.steps + 1) * dt
         a = np.array([state.x, state.y])
         b = np.array([new.x, new.y])

@@ -84,6 +84,12 @@ class RobotState:
         """(x, y) [m]."""
         return (self.x, self.y)
 
+    def moved(self, v: float, omega: float, dt: float) -> RobotState:
+        """This pose moved by the twist (``v`` [m/s], ``omega`` [rad/s]) held for ``dt`` [s],
+        the unicycle integrated exactly (an arc, or a straight segment), with that twist."""
+        x, y, th = unicycle_arc(self.x, self.y, self.theta, v, omega, dt)
+        return RobotState(x, y, float(wrap_angle(th)), v, omega)
+
 
 @dataclass(frozen=True)
 class Command:
@@ -121,5 +127,4 @@ def step(spec: RobotSpec, state: RobotState, cmd: Command, dt: float) -> RobotSt
     (an arc of a circle, or a straight segment).
     """
     c = clip_command(spec, state, cmd, dt)
-    x, y, th = unicycle_arc(state.x, state.y, state.theta, c.v, c.omega, dt)
-    return RobotState(x, y, float(wrap_angle(th)), c.v, c.omega)
+    return state.moved(c.v, c.omega, dt)
