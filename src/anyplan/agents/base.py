@@ -26,7 +26,7 @@ from anyplan.world.robot import Command, RobotState
 from anyplan.world.scenario import Scenario
 
 __all__ = ["Observation", "Agent", "AgentStats", "TrackingLog", "TrackedStats", "AGENTS",
-           "make_agent"]
+           "make_agent", "checked_pose_margin"]
 
 
 @dataclass(frozen=True)
@@ -156,6 +156,18 @@ AGENTS.register("dovs", "anyplan.agents.dovs:DOVSAgent")
 AGENTS.register("st-bitstar", "anyplan.agents.spacetime:SpaceTimeBITStarAgent")
 AGENTS.register("orca", "anyplan.agents.orca:ORCAAgent")  # optional extra: pyrvo
 AGENTS.register("policy", "anyplan.agents.policy:PolicyAgent")  # e.g. trained in anyplan.gym
+
+
+def checked_pose_margin(value: Any) -> float:
+    """The ``pose_margin_m`` setting [m] of the agents that keep clearance for a localization
+    error (``seq-bitstar``, ``st-bitstar``, ``bitstar``).
+
+    Raises:
+        ValueError: not a finite number >= 0 (the message names the setting).
+    """
+    if not (isinstance(value, int | float) and 0.0 <= value < math.inf):
+        raise ValueError(f"pose_margin_m: must be >= 0, got {value!r}")
+    return float(value)
 
 
 def _discover(registry: Registry[type[Agent]]) -> None:

@@ -15,12 +15,11 @@ what lets the spline round the corners of BIT*'s path without cutting into an ob
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
 
-from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
+from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog, checked_pose_margin
 from anyplan.agents.stats import BITStarStats
 from anyplan.agents.warmup import warm_up_kernels
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
@@ -61,9 +60,7 @@ class BITStarAgent(Agent):
             raise ValueError(f"time_budget_s must be > 0 s, got {time_budget_s}")
         if not 0.0 <= smooth_margin <= plan_margin:
             raise ValueError("smooth_margin must be in [0, plan_margin]")
-        if not (isinstance(pose_margin_m, int | float) and 0.0 <= pose_margin_m < math.inf):
-            raise ValueError(f"pose_margin_m: must be >= 0, got {pose_margin_m!r}")
-        self.pose_margin_m = float(pose_margin_m)
+        self.pose_margin_m = checked_pose_margin(pose_margin_m)
         if max_attempts < 1:
             raise ValueError(f"max_attempts must be >= 1, got {max_attempts}")
         self.time_budget_s = float(time_budget_s)

@@ -14,13 +14,12 @@ behaviour). Moving obstacles are predicted with a constant twist
 
 from __future__ import annotations
 
-import math
 import time
 from typing import Any
 
 import numpy as np
 
-from anyplan.agents.base import Observation
+from anyplan.agents.base import Observation, checked_pose_margin
 from anyplan.agents.replanning import MAX_BACKOFF_S, ReplanningAgent
 from anyplan.agents.safety import SafetyConfig, SafetyGuard
 from anyplan.agents.stats import SequentialStats
@@ -87,8 +86,7 @@ class SequentialBITStarAgent(ReplanningAgent):
             raise ValueError("give either config or loop options, not both")
         if not 0.0 <= smooth_margin <= plan_margin:
             raise ValueError("smooth_margin: must be in [0, plan_margin]")
-        if not (isinstance(pose_margin_m, int | float) and 0.0 <= pose_margin_m < math.inf):
-            raise ValueError(f"pose_margin_m: must be >= 0, got {pose_margin_m!r}")
+        pose_margin_m = checked_pose_margin(pose_margin_m)
         super().__init__(check_period_s=check_period_s,
                          min_replan_interval_s=min_replan_interval_s, urgent_s=urgent_s,
                          planning_delay=planning_delay, max_delay_s=config.max_time_s,
@@ -96,7 +94,7 @@ class SequentialBITStarAgent(ReplanningAgent):
         self.config = config
         self.plan_margin = float(plan_margin)
         self.smooth_margin = float(smooth_margin)
-        self.pose_margin_m = float(pose_margin_m)
+        self.pose_margin_m = pose_margin_m
         self.grid_step = float(grid_step)
         self.safety = bool(safety)
         self.safety_config = safety_config or SafetyConfig(margin=config.margin,

@@ -361,7 +361,7 @@ def reachable_margin(obstacles: ObstacleSet, start: np.ndarray | tuple[float, fl
 
     if not most > 0.0 or ok(most):
         return max(float(most), 0.0)
-    lo, hi = 0.0, float(most)
+    hi = float(most)
     if not ok(min(tol, hi)):
         return 0.0
     lo = min(tol, hi)
