@@ -25,6 +25,7 @@ import numpy as np
 from anyplan.config import setting, validate
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.moving import closest_approach
+from anyplan.geometry.se2 import dot2
 from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
 from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.motion import brake_to_rest, come_to_rest, polyline_trajectory
@@ -412,7 +413,7 @@ def reachable_discs(preds: Sequence[PredictedObstacle], t: float, p: np.ndarray,
         if float(getattr(o, "until", math.inf)) < t:
             continue
         q = o.positions(np.array([t]))[0]
-        if float(np.dot(q - p, u)) < 0.0:
+        if dot2(q - p, u) < 0.0:
             continue
         speed = max(float(o.max_speed) + extra_speed, min_speed)
         growth = RadiusGrowth(t, np.array([0.0, horizon_s]), np.array([0.0, speed * horizon_s]))

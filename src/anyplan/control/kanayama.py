@@ -77,8 +77,9 @@ class KanayamaController:
         ts = t + self.dt * np.linspace(0.0, 1.0, 5)
         x, y, th, v, _ = traj.sample(ts)
         # Simpson's rule: v is piecewise linear in time, so this is exact within a segment.
-        w_s = np.array([1.0, 4.0, 2.0, 4.0, 1.0]) / 12.0
-        v_r = float(w_s @ v)
+        # written out, not ``w @ v`` (BLAS: machine-dependent bits, geometry.se2)
+        v_r = (float(v[0]) + 4.0 * float(v[1]) + 2.0 * float(v[2]) + 4.0 * float(v[3])
+               + float(v[4])) / 12.0
         w_r = float(np.sum(wrap_angle(np.diff(th)))) / self.dt
         return float(x[0]), float(y[0]), float(th[0]), v_r, w_r
 

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from anyplan.experiments.generate import P3DX, GenerationError
+from anyplan.geometry.se2 import dot2, dot2_rows
 from anyplan.trajectory.path import polyline_length
 from anyplan.world.scenario import Scenario, scenario_from_dict
 
@@ -127,7 +128,7 @@ def _route_distance(p: np.ndarray, route: np.ndarray) -> np.ndarray:
     best = np.full(len(p), np.inf)
     for a, b in zip(route[:-1], route[1:], strict=True):
         ab = b - a
-        u = np.clip(((p - a) @ ab) / float(ab @ ab), 0.0, 1.0)
+        u = np.clip(dot2_rows(p - a, ab) / dot2(ab, ab), 0.0, 1.0)
         best = np.minimum(best, np.hypot(*(p - (a + u[:, None] * ab)).T))
     return best
 

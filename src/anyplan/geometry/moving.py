@@ -22,6 +22,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from anyplan.geometry.se2 import dot2
+
 __all__ = [
     "closest_approach_straight",
     "first_contact_straight",
@@ -51,8 +53,8 @@ def closest_approach_straight(p: np.ndarray, u: np.ndarray, q: np.ndarray, w: np
     """
     d0 = np.asarray(p, float) - np.asarray(q, float)
     dv = np.asarray(u, float) - np.asarray(w, float)
-    vv = float(dv @ dv)
-    t = t0 if vv <= 0.0 else min(max(-float(d0 @ dv) / vv, t0), t1)
+    vv = dot2(dv, dv)
+    t = t0 if vv <= 0.0 else min(max(-dot2(d0, dv) / vv, t0), t1)
     d = d0 + dv * t
     return t, float(math.hypot(d[0], d[1]))
 
@@ -62,9 +64,9 @@ def first_contact_straight(p: np.ndarray, u: np.ndarray, q: np.ndarray, w: np.nd
     """First time in [t0, t1] at which ``|p + u t - (q + w t)| <= radius``, or None."""
     d0 = np.asarray(p, float) - np.asarray(q, float)
     dv = np.asarray(u, float) - np.asarray(w, float)
-    a = float(dv @ dv)
-    b = 2.0 * float(d0 @ dv)
-    c = float(d0 @ d0) - radius * radius
+    a = dot2(dv, dv)
+    b = 2.0 * dot2(d0, dv)
+    c = dot2(d0, d0) - radius * radius
     # distance^2 - radius^2 = a t^2 + b t + c
     at_t0 = a * t0 * t0 + b * t0 + c
     if at_t0 <= 0.0:

@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from anyplan.geometry.se2 import transform_points
+
 __all__ = ["Circle", "Polygon", "Shape", "rectangle", "square", "regular_polygon"]
 
 
@@ -154,7 +156,7 @@ def rectangle(center: Sequence[float] | np.ndarray, size: Sequence[float] | np.n
     local = np.array([[-w, -h], [w, -h], [w, h], [-w, h]], dtype=float) / 2.0
     c, s = np.cos(angle), np.sin(angle)
     rot = np.array([[c, -s], [s, c]])
-    return Polygon(local @ rot.T + np.asarray(center, dtype=float).reshape(2))
+    return Polygon(transform_points(local, rot) + np.asarray(center, dtype=float).reshape(2))
 
 
 def square(center: Sequence[float] | np.ndarray, side: float) -> Polygon:

@@ -145,6 +145,20 @@ def ct_transition(x: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return out, F
 
 
+def _inv2(S: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Inverses and determinants of 2 x 2 matrices S (..., 2, 2), written out: LAPACK's
+    (``np.linalg.inv``, ``det``) run BLAS kernels chosen for the CPU, and the same seeded run
+    gave other tracks on another machine (``anyplan.geometry.se2``)."""
+    a, b, c, d = S[..., 0, 0], S[..., 0, 1], S[..., 1, 0], S[..., 1, 1]
+    det = a * d - b * c
+    inv = np.empty_like(S)
+    inv[..., 0, 0] = d / det
+    inv[..., 0, 1] = -b / det
+    inv[..., 1, 0] = -c / det
+    inv[..., 1, 1] = a / det
+    return inv, det
+
+
 def _accel_q(T: np.ndarray, q: float) -> np.ndarray:
     """Discrete white-noise-acceleration covariance (N, 5, 5) on [x, y, vx, vy]."""
     Q = np.zeros((len(T), 5, 5))
@@ -226,19 +240,19 @@ class Tracker:
         """Squared Mahalanobis distances (N, 2) of positions z (N, 2) from tracks ``idx``
         (predicted to the detection time) under each model."""
         y, S = self._innovation(self.x[idx], self.P[idx], z)
-        return np.asarray(np.einsum("nma,nmab,nmb->nm", y, np.linalg.inv(S), y))
+        return np.asarray(np.einsum("nma,nmab,nmb->nm", y, _inv2(S)[0], y))
 
     def _update(self, idx: np.ndarray, z: np.ndarray) -> None:
         """Kalman update of tracks ``idx`` (already at the detection time) with positions z (N, 2)."""
         x, P = self.x[idx], self.P[idx]
         y, S = self._innovation(x, P, z)
-        Sinv = np.linalg.inv(S)
+        Sinv, det = _inv2(S)
         K = np.einsum("nmab,nmbc->nmac", P[:, :, :, :2], Sinv)   # (n, m, 5, 2)
         x = x + np.einsum("nmab,nmb->nma", K, y)
         P = P - np.einsum("nmab,nmbc->nmac", K, P[:, :, :2, :])
         P = 0.5 * (P + np.swapaxes(P, -1, -2))
         md = np.einsum("nma,nmab,nmb->nm", y, Sinv, y)
-        lik = np.exp(-0.5 * np.minimum(md, 700.0)) / (2 * math.pi * np.sqrt(np.linalg.det(S)))
+        lik = np.exp(-0.5 * np.minimum(md, 700.0)) / (2 * math.pi * np.sqrt(det))
         mu = self.mu[idx] * (lik + 1e-300)
         self.mu[idx] = mu / mu.sum(axis=1, keepdims=True)
         self.x[idx], self.P[idx] = x, P

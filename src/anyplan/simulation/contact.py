@@ -22,6 +22,7 @@ import numpy as np
 
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.moving import first_contact_straight
+from anyplan.geometry.se2 import dot2
 from anyplan.geometry.shapes import Circle, Polygon
 
 __all__ = ["ROBOT_CAUSED_SPEED", "approach_speed", "robot_caused", "nearest_obstacle_point",
@@ -141,5 +142,5 @@ def disc_contact(p: np.ndarray, u: np.ndarray, q: np.ndarray, w: np.ndarray, rea
         return float(tc)
     d0 = np.asarray(p, float) - np.asarray(q, float)
     dv = np.asarray(u, float) - np.asarray(w, float)
-    vv = float(dv @ dv)
-    return t0 if vv <= 0.0 else float(min(max(-float(d0 @ dv) / vv, t0), t1))
+    vv = dot2(dv, dv)
+    return t0 if vv <= 0.0 else float(min(max(-dot2(d0, dv) / vv, t0), t1))

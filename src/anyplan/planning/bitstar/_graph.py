@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit
 
 from anyplan.geometry.collision import ObstacleSet
+from anyplan.geometry.se2 import transform_points
 from anyplan.planning.bitstar import _tree
 from anyplan.planning.bitstar._tree import Tree
 
@@ -189,7 +190,7 @@ class InformedSampler:
                 rho = np.sqrt(u[:, 0])
                 th = 2.0 * math.pi * u[:, 1]
                 local = np.column_stack([a * rho * np.cos(th), b * rho * np.sin(th)])
-                pts = local @ self.rot.T + self.center
+                pts = transform_points(local, self.rot) + self.center
                 inside = ((pts[:, 0] > xmin) & (pts[:, 0] < xmax)
                           & (pts[:, 1] > ymin) & (pts[:, 1] < ymax))
                 pts = pts[inside]

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from anyplan.geometry.collision import ObstacleSet
+from anyplan.geometry.se2 import dot2
 from anyplan.trajectory.path import clean_path
 from anyplan.trajectory.spline.clearance import worst_failures, worst_per_group
 from anyplan.trajectory.spline.curve import SmoothCurve
@@ -137,7 +138,7 @@ def _smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
                 q = curve.position(fu[j:j + 1])[0]
                 a, b = pts[k], pts[k + 1]
                 ab = b - a
-                lam = float((q - a) @ ab) / float(ab @ ab)
+                lam = dot2(q - a, ab) / dot2(ab, ab)
                 split[k] = min(max(lam, 0.2), 0.8)
         new = [pts[0]]
         added = 0
