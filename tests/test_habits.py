@@ -5,6 +5,8 @@
   ``Examples:`` (doctests); derivations, conventions and figures belong in ``docs/``.
 * No docstring, comment or page of ``docs/`` cites a note kept outside the repository (the
   research notes beside it): cite the paper instead.
+* No BLAS (``@``, ``np.dot``, ``np.linalg``, ...) where a run's decisions are computed: its
+  kernels depend on the CPU (``tests/simulation/test_machine_independence.py``).
 """
 
 from __future__ import annotations
@@ -65,3 +67,27 @@ def test_no_reference_to_notes_outside_the_repository() -> None:
         text = p.read_text(encoding="utf-8")
         found += [f"{_rel(p)}: {note}" for note in OUTSIDE_NOTES if note in text]
     assert not found, "cite the paper, not a note outside the repository:\n" + "\n".join(found)
+
+
+#: Where BLAS may be used: pictures, the ORCA peer (pyrvo, not deterministic anyway) and the
+#: kernel warm-up (no decision).
+BLAS_ALLOWED = ("src/anyplan/viz/", "src/anyplan/agents/orca.py", "src/anyplan/agents/warmup.py")
+#: numpy's functions that call BLAS or LAPACK.
+BLAS_CALLS = ("dot", "vdot", "inner", "outer", "matmul", "tensordot", "kron")
+
+
+def test_no_blas_in_the_decisions() -> None:
+    found = []
+    for path in _sources():
+        rel = _rel(path)
+        if rel.startswith(BLAS_ALLOWED):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.BinOp | ast.AugAssign) and isinstance(node.op, ast.MatMult):
+                found.append(f"{rel}:{node.lineno} @")
+            elif isinstance(node, ast.Attribute) and (
+                    node.attr == "linalg"
+                    or (node.attr in BLAS_CALLS and isinstance(node.value, ast.Name)
+                        and node.value.id in ("np", "numpy"))):
+                found.append(f"{rel}:{node.lineno} {node.attr}")
+    assert not found, f"BLAS where a run decides (machine-dependent bits): {found}"
