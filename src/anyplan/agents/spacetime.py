@@ -428,11 +428,14 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
                 # as fast as untimed (within accept_s): no search; a slower timing stays a
                 # candidate against the loop's paths below
                 res = SequentialResult("collision_free", rest, out, [], 0)
-        # No long waits on uncertain discs: they end at the horizon, about a second after the
-        # waits of patience_s that the loop's timings allowed, so a long wait finds a motion
-        # only where the rest of the horizon can be waited out and no shorter wait could (3 of
-        # 1,114 such timings in the crowds, none of 621 on DynaBARN; docs/spacetime.md).
-        long_ok = not uncertain
+        # Long waits are useless with predictions that end before patience_s (nothing is left
+        # to wait for), and not tried among uncertain discs (tracked): they end at the horizon,
+        # about a second after the waits of patience_s that the loop's timings allowed, and a
+        # long wait found a motion in 3 of 1,114 such calls in the crowds, in none of 621 on
+        # DynaBARN (docs/spacetime.md).
+        long_ok = not (any(o.growth is not None for o in observed)
+                       or (uncertain and self.prediction_horizon_s is not None
+                           and self.patience_s >= self.prediction_horizon_s))
         long_bound = self.branch_and_bound and not uncertain
         cap = self._loop_cap(observed)
         if res is None:
