@@ -44,7 +44,8 @@ def _head_on_gap():
 
 
 def _fixed():
-    return {"planning_delay": 0.1, "search_budget_s": None,
+    # no wall-clock budget anywhere (improvement calls included): the same run under any load
+    return {"planning_delay": 0.1, "search_budget_s": None, "improve_budget_s": None,
             "config": SequentialConfig(max_iterations=8, wait_delays_s=(), batches_per_plan=2,
                                        max_time_s=10.0)}
 
