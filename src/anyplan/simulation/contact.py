@@ -21,8 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from anyplan.geometry.collision import ObstacleSet
-from anyplan.geometry.moving import first_contact_straight
-from anyplan.geometry.se2 import dot2
+from anyplan.geometry.moving import closest_approach_straight, first_contact_straight
 from anyplan.geometry.shapes import Circle, Polygon
 
 __all__ = ["ROBOT_CAUSED_SPEED", "approach_speed", "robot_caused", "nearest_obstacle_point",
@@ -140,7 +139,4 @@ def disc_contact(p: np.ndarray, u: np.ndarray, q: np.ndarray, w: np.ndarray, rea
     tc = first_contact_straight(p, u, q, w, reach, t0, t1)
     if tc is not None:
         return float(tc)
-    d0 = np.asarray(p, float) - np.asarray(q, float)
-    dv = np.asarray(u, float) - np.asarray(w, float)
-    vv = dot2(dv, dv)
-    return t0 if vv <= 0.0 else float(min(max(-dot2(d0, dv) / vv, t0), t1))
+    return closest_approach_straight(p, u, q, w, t0, t1)[0]
