@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from anyplan.world.motion import TrackMotion, UnicycleMotion, WaypointMotion
+from anyplan.world.motion import TrackMotion, UnicycleMotion, WaypointMotion, positions_of
 
 
 @settings(max_examples=100, deadline=None)
@@ -110,3 +110,27 @@ def test_one_time_gives_the_bits_of_the_array_path(track, u, at_knot):
             x, y, th, v, _ = m.state(t)
             assert (x, y) == (want[0], want[1])
             assert math.isfinite(th) and v >= 0.0
+
+
+@settings(max_examples=50, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(0, 12), nt=st.integers(0, 9))
+def test_positions_of_many_motions_is_each_ones_bit_for_bit(seed, n, nt):
+    """``positions_of`` (straight lines at once) gives every motion's own ``positions``, the
+    same bits, among turning, keyframed and straight motions, before and after their starts."""
+    rng = np.random.default_rng(seed)
+    ms = []
+    for k in range(n):
+        x0, y0, th = rng.uniform(-10, 10, 3)
+        kind = k % 4
+        if kind == 3:
+            ms.append(WaypointMotion(np.array([[0.0, x0, y0], [2.0, y0, x0], [3.5, 1.0, -1.0]])))
+        else:
+            om = 0.0 if kind < 2 else float(rng.uniform(-1, 1))
+            th = -0.0 if k == 1 else th
+            ms.append(UnicycleMotion(x0, y0, th, float(rng.uniform(-2, 2)), om,
+                                     float(rng.uniform(-1, 3))))
+    t = np.sort(rng.uniform(-2, 8, nt))
+    got = positions_of(ms, t)
+    assert got.shape == (n, nt, 2)
+    for k, m in enumerate(ms):
+        assert np.array_equal(got[k].view(np.int64), m.positions(t).view(np.int64))

@@ -26,7 +26,7 @@ from anyplan.config import setting, validate
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.moving import closest_approach
 from anyplan.geometry.se2 import dot2
-from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
+from anyplan.prediction.base import PredictedObstacle, RadiusGrowth, centres_of
 from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.motion import brake_to_rest, come_to_rest, polyline_trajectory
 from anyplan.trajectory.reference import HoldSegment
@@ -453,7 +453,7 @@ _Tracks = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 def _tracks(preds: Sequence[PredictedObstacle], ts: np.ndarray) -> _Tracks:
     """Every prediction's centres (n, len(ts), 2) [m] at ``ts`` [s], largest radii [m], speed
     bounds [m/s] and horizons [s]."""
-    q = np.stack([np.asarray(o.positions(ts), dtype=float) for o in preds])
+    q = centres_of(preds, ts)
     ro = np.array([_max_radius(o) for o in preds])
     vo = np.array([float(o.max_speed) for o in preds])
     until = np.array([float(getattr(o, "until", math.inf)) for o in preds])

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
+from anyplan.prediction.base import PredictedObstacle, RadiusGrowth, centres_of
 from anyplan.prediction.trap import first_trap
 from anyplan.world.robot import RobotState
 
@@ -66,10 +66,10 @@ class PlanningPredictions:
             return preds  # the same object: certain predictions
         r, v, m = self.spec.radius, self.spec.v_max, self.config.margin
         out = []
-        for o in preds:
+        centres = centres_of(preds, np.array([t]))[:, 0]
+        for o, q in zip(preds, centres, strict=True):
             if o.until < t:
                 continue
-            q = o.positions(np.array([t]))[0]
             d = float(np.hypot(*(q - p)))
             if d - (v + o.max_speed) * (o.until - t) - r - m - o.max_radius > 0.0:
                 continue  # out of reach within the horizon

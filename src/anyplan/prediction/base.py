@@ -9,10 +9,10 @@ from typing import Protocol
 
 import numpy as np
 
-from anyplan.world.motion import Motion, UnicycleMotion
+from anyplan.world.motion import Motion, UnicycleMotion, positions_of
 
 __all__ = ["ObstacleObservation", "PredictedObstacle", "Predictor", "ConstantTwistPredictor",
-           "RadiusGrowth"]
+           "RadiusGrowth", "centres_of"]
 
 
 def _normalised(taus: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -177,6 +177,14 @@ class PredictedObstacle:
     def max_speed(self) -> float:
         """Upper bound on the predicted speed [m/s]."""
         return self.motion.max_speed
+
+
+def centres_of(preds: Sequence[PredictedObstacle], t: np.ndarray) -> np.ndarray:
+    """Every prediction's centres (len(preds), len(t), 2) [m] at times ``t`` (T,) [s], row k
+    bit for bit ``preds[k].positions(t)`` (straight motions at once:
+    :func:`~anyplan.world.motion.positions_of`); any object with ``positions`` may stand in
+    for a prediction."""
+    return positions_of([o.motion if type(o) is PredictedObstacle else o for o in preds], t)
 
 
 class Predictor(Protocol):

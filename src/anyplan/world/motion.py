@@ -17,12 +17,13 @@ from __future__ import annotations
 import bisect
 import functools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
-__all__ = ["Jump", "Motion", "UnicycleMotion", "WaypointMotion", "TrackMotion"]
+__all__ = ["Jump", "Motion", "UnicycleMotion", "WaypointMotion", "TrackMotion", "positions_of"]
 
 
 #: Tolerance [s] on a jump's time (:meth:`Motion.jumps`).
@@ -151,6 +152,33 @@ class UnicycleMotion(Motion):
             return None
         r = self.v / self.omega
         return np.array([self.x0 - r * math.sin(self.theta0), self.y0 + r * math.cos(self.theta0)])
+
+
+def positions_of(motions: Sequence[Any], t: np.ndarray) -> np.ndarray:
+    """Every motion's positions (len(motions), len(t), 2) [m] at times ``t`` (T,) [s]: each
+    row is ``motions[k].positions(t)``, bit for bit (any object with ``positions`` may stand
+    in for a motion). The straight :class:`UnicycleMotion` rows are computed at once, element
+    by element the operations of its ``positions`` (a planner asks 40-60 tracked people
+    where they are, many times per replanning)."""
+    t = np.asarray(t, dtype=float).ravel()
+    out = np.empty((len(motions), t.size, 2))
+    lines = [k for k, m in enumerate(motions)
+             if type(m) is UnicycleMotion and m.omega == 0.0]
+    if lines:
+        ms: list[UnicycleMotion] = [motions[k] for k in lines]
+        f = np.array([_straight_factors(m.theta0) for m in ms])
+        x0, y0, v, t0 = (np.array([getattr(m, a) for m in ms], dtype=float)
+                         for a in ("x0", "y0", "v", "start_time"))
+        tau = np.maximum(t[None, :] - t0[:, None], 0.0)
+        chord = v[:, None] * tau * f[:, 2:3]
+        out[lines, :, 0] = x0[:, None] + chord * f[:, 0:1]
+        out[lines, :, 1] = y0[:, None] + chord * f[:, 1:2]
+    if len(lines) < len(motions):
+        done = set(lines)
+        for k, m in enumerate(motions):
+            if k not in done:
+                out[k] = np.asarray(m.positions(t), dtype=float).reshape(t.size, 2)
+    return out
 
 
 def _interp1(x: float, ts: tuple[float, ...], vs: tuple[float, ...]) -> float:
