@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,6 +15,22 @@ if os.environ.get("CI"):
     settings.load_profile("ci")
 
 os.environ.setdefault("MPLBACKEND", "Agg")
+
+
+def shared_benchmark(*parts: str) -> Path:
+    """A file of the benchmark data beside the checkout (``../shared/benchmarks/...``, which the
+    package does not ship), found above the tests or the working directory; where it is absent,
+    the path it would have (tests that need it skip)."""
+    rel = Path("shared", "benchmarks", *parts)
+    bases = [*Path(__file__).resolve().parents, *Path.cwd().resolve().parents]
+    return next((b / rel for b in bases if (b / rel).exists()), bases[1] / rel)
+
+
+DYNABARN_WORLDS = shared_benchmark("dynabarn", "worlds.json")
+BARN_WORLDS = shared_benchmark("barn", "worlds.json")
+CROWDS = shared_benchmark("crowds")
+needs_dynabarn = pytest.mark.skipif(not DYNABARN_WORLDS.is_file(),
+                                    reason="shared DynaBARN worlds.json not present")
 
 
 @pytest.fixture

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,6 +15,7 @@ from anyplan.experiments.gaps import WALL_T, WALL_X, gap_world, issue_gap_scenar
 from anyplan.planning.sequential import SequentialConfig
 from anyplan.simulation import SimConfig, simulate
 from anyplan.world.scenario import scenario_from_dict
+from tests.conftest import DYNABARN_WORLDS as _DYNABARN
 from tests.conftest import fast_at_a_wall_dict, head_on_corridor_dict
 
 P3DX = {"radius": 0.3, "v_max": 0.4, "omega_max": 0.4, "a_max": 0.4, "alpha_max": 1.0,
@@ -304,7 +304,6 @@ def test_the_motion_taken_up_starts_at_the_robots_speed():
     assert getattr(tr, "feasible", True)
 
 
-_DYNABARN = Path(__file__).resolve().parents[3] / "shared" / "benchmarks" / "dynabarn" / "worlds.json"
 
 
 @pytest.mark.skipif(not _DYNABARN.is_file(), reason="shared DynaBARN worlds.json not present")

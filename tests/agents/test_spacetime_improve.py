@@ -2,17 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from anyplan.agents import AGENTS, make_agent
 from anyplan.simulation import simulate
 from anyplan.world.scenario import scenario_from_dict
-
-_DYNABARN = Path(__file__).resolve().parents[3] / "shared" / "benchmarks" / "dynabarn" / "worlds.json"
-needs_dynabarn = pytest.mark.skipif(not _DYNABARN.is_file(),
-                                    reason="shared DynaBARN worlds.json not present")
+from tests.conftest import DYNABARN_WORLDS as _DYNABARN
+from tests.conftest import needs_dynabarn
 
 
 def _world(i: int):

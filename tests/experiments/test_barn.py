@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -25,17 +24,7 @@ from anyplan.experiments.barn import (
 )
 from anyplan.geometry.shapes import Circle
 from anyplan.world.scenario import load_scenario, scenario_from_dict
-
-
-def _find_shared() -> Path | None:
-    rel = Path("shared") / "benchmarks" / "barn" / "worlds.json"
-    for base in [*Path(__file__).resolve().parents, *Path.cwd().resolve().parents]:
-        if (base / rel).is_file():
-            return base / rel
-    return None
-
-
-SHARED = _find_shared()
+from tests.conftest import BARN_WORLDS as SHARED
 
 
 def _walls() -> list[list[float]]:
@@ -101,7 +90,7 @@ def _check_shipped(worlds):
         assert sc.robot.goal[1] > c[:, 1].max() + 1.0  # the goal lies past the field's far end
 
 
-@pytest.mark.skipif(SHARED is None, reason="shared BARN worlds.json not present")
+@pytest.mark.skipif(not SHARED.is_file(), reason="shared BARN worlds.json not present")
 def test_shipped_worlds_convert_exactly_and_fit_the_arena():
     worlds = load_worlds(SHARED)
     assert [w["world"] for w in worlds] == list(range(300))
@@ -109,7 +98,7 @@ def test_shipped_worlds_convert_exactly_and_fit_the_arena():
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(SHARED is None, reason="shared BARN worlds.json not present")
+@pytest.mark.skipif(not SHARED.is_file(), reason="shared BARN worlds.json not present")
 def test_every_shipped_world_converts_exactly_and_fits_the_arena():
     _check_shipped(load_worlds(SHARED))
 

@@ -17,8 +17,7 @@ from anyplan.experiments.crowds import (
     read_obsmat,
 )
 from anyplan.world import load_scenario, scenario_from_dict
-
-CROWDS = Path("/work/shared/benchmarks/crowds")
+from tests.conftest import CROWDS
 
 
 def _write_obsmat(path: Path, n_people=6, n_frames=200, seed=0) -> dict[int, np.ndarray]:

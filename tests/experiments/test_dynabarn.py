@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,8 +18,7 @@ from anyplan.experiments.dynabarn import (
     world_to_scenario,
 )
 from anyplan.world.scenario import load_scenario
-
-SHARED = Path(__file__).resolve().parents[3] / "shared" / "benchmarks" / "dynabarn" / "worlds.json"
+from tests.conftest import DYNABARN_WORLDS as SHARED
 
 WORLD = {"world": 7, "walls": [
     {"name": "back_wall", "pose": [-10.0, 0.0, 0.5, 0, 0, 0], "size": [0.5, 20.0, 1.0]},

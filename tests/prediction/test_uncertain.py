@@ -4,7 +4,6 @@ of the uncertainty radius on recorded pedestrians."""
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,8 +16,7 @@ from anyplan.prediction.detection import Detection
 from anyplan.prediction.tracking import Tracker, TrackerConfig
 from anyplan.prediction.uncertain import UncertaintyModel
 from anyplan.world.motion import UnicycleMotion
-
-CROWDS = Path("/work/shared/benchmarks/crowds")
+from tests.conftest import CROWDS
 
 
 def test_radius_growth_is_monotone_capped_and_its_rate_bounds_the_slope():

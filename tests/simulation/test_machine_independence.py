@@ -13,14 +13,12 @@ import hashlib
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from anyplan.geometry.se2 import dot2, dot2_rows, transform_points
-
-_DYNABARN = Path(__file__).resolve().parents[3] / "shared" / "benchmarks" / "dynabarn" / "worlds.json"
+from tests.conftest import DYNABARN_WORLDS as _DYNABARN
 
 _RUN = """
 import hashlib, sys
