@@ -20,6 +20,8 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import numpy as np
+
 from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
 from anyplan.agents.stats import SequentialStats
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
@@ -271,7 +273,7 @@ class ReplanningAgent(Agent):
                 self._switch()
         elif (self.trajectory is not None and self.pending is None
               and (t - self._last_check >= self._period() - 1e-9
-                   or self._requested is not None)):
+                   or self._requested is not None or self._new_within_reach(obs, preds))):
             self._check(obs, preds)
         traj = self.trajectory
         if traj is None:
@@ -297,6 +299,29 @@ class ReplanningAgent(Agent):
         new = names - self._seen
         self._seen |= names
         return bool(new)
+
+    def _new_within_reach(self, obs: Observation, preds: list[PredictedObstacle]) -> bool:
+        """Whether an obstacle not seen before is close enough to meet the robot before the
+        next periodic check and a brake from there could end: its gap to the robot's disc
+        [m] at most (robot speed + its speed) x (check period + braking time). Then the motion
+        in use is checked at once, not up to a period later: a person stepping out 0.7 m
+        ahead of a robot at 1 m/s (ETH hotel window 7, seed 2) was seen 0.1 s before the
+        check, and the robot stopped 2 mm too late. Obstacles first seen farther away wait
+        for the period, as before: on DynaBARN ``tracked`` checking at once whatever the
+        distance (12-20 m, out from behind walls) shifted every later check, and 231 of 400
+        runs reached against 249."""
+        new = [p for p in preds if p.name not in self._seen]
+        if not new:
+            return False
+        r, spec = obs.robot, self.spec
+        v = abs(r.v)
+        window = self._period() + v / spec.a_max
+        for p in new:
+            q = p.positions(np.array([obs.t]))[0]
+            gap = math.hypot(q[0] - r.x, q[1] - r.y) - spec.radius - p.radius
+            if gap <= (v + p.max_speed) * window:
+                return True
+        return False
 
     def _arrived(self, obs: Observation, traj: Trajectory) -> bool:
         """The motion is over and the robot within the goal tolerance."""
