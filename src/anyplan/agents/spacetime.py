@@ -142,9 +142,6 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             view has no announced motion (``twist``, ``tracked``); announced motions keep
             ``max_iterations`` (8). None: ``max_iterations`` always (``docs/perception.md``,
             "Planning time": against 8 over 757 paired runs, no outcome worse, p95 0.6 times).
-        twist_iterations: The cap instead while the obstacles in view are predicted from
-            exact twists (as ``twist_check_period_s``); None: ``extrapolated_iterations``.
-            On DynaBARN ``twist`` (400 paired runs) 3 reached 355 against 347 with 4.
         **kwargs: Further options of :class:`SequentialBITStarAgent` (planning_delay, ...).
     """
 
@@ -168,8 +165,7 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
                  reach_min_speed_mps: float = 0.0, search_budget_s: float | None = 0.02,
                  improve_calls: int = 25, improve_budget_s: float | None = 0.01,
                  twist_check_period_s: float | None = 0.1, swerves: bool = True,
-                 extrapolated_iterations: int | None = 4, twist_iterations: int | None = 3,
-                 **kwargs: Any) -> None:
+                 extrapolated_iterations: int | None = 4, **kwargs: Any) -> None:
         loop = {k: kwargs.pop(k) for k in list(kwargs) if k in _LOOP_FIELDS}  # e.g. from --set
         if config is None:
             config = dataclasses.replace(_DEFAULT_LOOP, **loop)
@@ -180,13 +176,12 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
                           ("lattice_dt_s", lattice_dt_s)):
             if not (isinstance(val, int | float) and val > 0.0):
                 raise ValueError(f"{name}: must be > 0, got {val!r}")
-        for name, limit in (("horizon_s", horizon_s), ("announced_horizon_s", announced_horizon_s),
-                            ("search_budget_s", search_budget_s),
-                            ("improve_budget_s", improve_budget_s),
-                            ("twist_check_period_s", twist_check_period_s)):
-            if limit is not None and not (isinstance(limit, int | float) and limit > 0.0):
-                raise ValueError(f"{name}: must be > 0 or null, got {limit!r}")
+        if horizon_s is not None and not (isinstance(horizon_s, int | float) and horizon_s > 0.0):
+            raise ValueError(f"horizon_s: must be > 0 or null, got {horizon_s!r}")
         self.horizon_s = None if horizon_s is None else float(horizon_s)
+        if announced_horizon_s is not None and not (isinstance(announced_horizon_s, int | float)
+                                                    and announced_horizon_s > 0.0):
+            raise ValueError(f"announced_horizon_s: must be > 0 or null, got {announced_horizon_s!r}")
         self.announced_horizon_s = None if announced_horizon_s is None else float(announced_horizon_s)
         if guard not in ("growth", "horizon", "never"):
             raise ValueError(f"guard: 'growth', 'horizon' or 'never', got {guard!r}")
@@ -205,11 +200,10 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
             if not isinstance(flag, bool):
                 raise ValueError(f"{name}: must be true or false, got {flag!r}")
         self.passive_safety, self.swerves = passive_safety, swerves
-        for name, cap in (("extrapolated_iterations", extrapolated_iterations),
-                          ("twist_iterations", twist_iterations)):
-            if cap is not None and (isinstance(cap, bool) or not (isinstance(cap, int) and cap >= 1)):
-                raise ValueError(f"{name}: must be an integer >= 1 or null, got {cap!r}")
-        self.extrapolated_iterations, self.twist_iterations = extrapolated_iterations, twist_iterations
+        cap = extrapolated_iterations
+        if cap is not None and (isinstance(cap, bool) or not (isinstance(cap, int) and cap >= 1)):
+            raise ValueError(f"extrapolated_iterations: must be an integer >= 1 or null, got {cap!r}")
+        self.extrapolated_iterations = cap
         if plan_extra_m is not None and not (isinstance(plan_extra_m, int | float)
                                              and plan_extra_m >= 0.0):
             raise ValueError(f"plan_extra_m: must be >= 0 or null, got {plan_extra_m!r}")
@@ -217,6 +211,11 @@ class SpaceTimeBITStarAgent(PlanningPredictions, SafetyDecisions, SequentialBITS
         if not (isinstance(accept_s, int | float) and 0.0 <= accept_s <= patience_s):
             raise ValueError(f"accept_s: must be in [0, patience_s], got {accept_s!r}")
         self.accept_s = float(accept_s)
+        for name, limit in (("search_budget_s", search_budget_s),
+                            ("improve_budget_s", improve_budget_s),
+                            ("twist_check_period_s", twist_check_period_s)):
+            if limit is not None and not (isinstance(limit, int | float) and limit > 0.0):
+                raise ValueError(f"{name}: must be > 0 or null, got {limit!r}")
         self.search_budget_s = None if search_budget_s is None else float(search_budget_s)
         self.improve_budget_s = None if improve_budget_s is None else float(improve_budget_s)
         self.twist_check_period_s = (None if twist_check_period_s is None

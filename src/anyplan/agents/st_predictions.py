@@ -44,7 +44,6 @@ class PlanningPredictions:
     outrun_margin_mps: float | None
     announced_horizon_s: float | None
     extrapolated_iterations: int | None
-    twist_iterations: int | None
     twist_check_period_s: float | None
     check_period_s: float
     _exact_twists: bool
@@ -190,7 +189,7 @@ class PlanningPredictions:
         """Whether the obstacles in view are predicted from exact twists (``twist``: their
         predictions end, without uncertain discs), from the latest step that observed any."""
         if preds:
-            self._exact_twists = _exact_twists(preds)
+            self._exact_twists = all(o.until < math.inf and o.growth is None for o in preds)
 
     def _period(self) -> float:
         """The check period in force [s]: ``twist_check_period_s`` while the obstacles in view
@@ -202,17 +201,8 @@ class PlanningPredictions:
     def _loop_cap(self, observed: list[PredictedObstacle]) -> int | None:
         """The cap on the loop's paths in this replanning: ``extrapolated_iterations`` while an
         obstacle in view has no announced motion (its prediction ends: ``twist``, ``tracked``),
-        ``twist_iterations`` (if set) while every one is predicted from an exact twist, else
-        None (the loop's own ``max_iterations``). A deep search for detours threads paths
+        else None (the loop's own ``max_iterations``). A deep search for detours threads paths
         between guesses; measured, it bought nothing there (``docs/perception.md``)."""
-        if not any(o.until < math.inf for o in observed):
-            return None
-        if self.twist_iterations is not None and _exact_twists(observed):
-            return self.twist_iterations
-        return self.extrapolated_iterations
-
-
-def _exact_twists(preds: list[PredictedObstacle]) -> bool:
-    """Whether every prediction is extrapolated from an exact twist (``twist`` perception: it
-    ends, and its disc does not grow)."""
-    return all(o.until < math.inf and o.growth is None for o in preds)
+        if any(o.until < math.inf for o in observed):
+            return self.extrapolated_iterations
+        return None
