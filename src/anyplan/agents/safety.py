@@ -409,10 +409,9 @@ def reachable_discs(preds: Sequence[PredictedObstacle], t: float, p: np.ndarray,
     """
     u = np.array([math.cos(heading), math.sin(heading)])
     out = []
-    for o in preds:
+    for o, q in zip(preds, centres_of(preds, np.array([t]))[:, 0], strict=True):
         if float(getattr(o, "until", math.inf)) < t:
             continue
-        q = o.positions(np.array([t]))[0]
         if dot2(q - p, u) < 0.0:
             continue
         speed = max(float(o.max_speed) + extra_speed, min_speed)
