@@ -16,7 +16,7 @@ from anyplan.planning.sequential import SequentialConfig
 from anyplan.simulation import SimConfig, simulate
 from anyplan.world.scenario import scenario_from_dict
 from tests.conftest import DYNABARN_WORLDS as _DYNABARN
-from tests.conftest import fast_at_a_wall_dict, head_on_corridor_dict
+from tests.conftest import fast_at_a_wall_dict, head_on_corridor_dict, needs_dynabarn
 
 P3DX = {"radius": 0.3, "v_max": 0.4, "omega_max": 0.4, "a_max": 0.4, "alpha_max": 1.0,
         "goal_tolerance": 0.2}
@@ -306,7 +306,7 @@ def test_the_motion_taken_up_starts_at_the_robots_speed():
 
 
 
-@pytest.mark.skipif(not _DYNABARN.is_file(), reason="shared DynaBARN worlds.json not present")
+@needs_dynabarn
 def test_dynabarn_53_known_motion_no_robot_caused_collision():
     # World 53 with the obstacles' motions announced (oracle), deterministic settings: at 1.3 s
     # the robot (1.5 m/s, 3 cm from a static obstacle) took up a reference starting at 0.03 m/s,
@@ -620,7 +620,7 @@ def test_when_no_fallback_is_passively_safe_the_one_at_rest_soonest_ranks_first(
     assert k_brake[1] > k_drive[1]
 
 
-@pytest.mark.skipif(not _DYNABARN.is_file(), reason="shared DynaBARN worlds.json not present")
+@needs_dynabarn
 def test_branch_and_bound_prunes_paths_that_cannot_arrive_earlier(monkeypatch):
     # DynaBARN 40-47, motions announced, the first replanning only. With the bound, the shortest
     # path is timed with long waits first and a detour whose untimed motion arrives no earlier
@@ -663,7 +663,7 @@ def test_branch_and_bound_prunes_paths_that_cannot_arrive_earlier(monkeypatch):
     assert all(nominal >= best - 1e-9 for nominal, best in pruned)
 
 
-@pytest.mark.skipif(not _DYNABARN.is_file(), reason="shared DynaBARN worlds.json not present")
+@needs_dynabarn
 def test_search_budget_takes_the_best_candidate_once_one_is_timed():
     # DynaBARN 28 (motions announced): with no time left once a path is timed, the first
     # replanning stops at its first candidate, which it takes (verified free); the full search

@@ -19,6 +19,7 @@ from anyplan.experiments.dynabarn import (
 )
 from anyplan.world.scenario import load_scenario
 from tests.conftest import DYNABARN_WORLDS as SHARED
+from tests.conftest import needs_dynabarn
 
 WORLD = {"world": 7, "walls": [
     {"name": "back_wall", "pose": [-10.0, 0.0, 0.5, 0, 0, 0], "size": [0.5, 20.0, 1.0]},
@@ -63,7 +64,7 @@ def test_keyframes_are_exact_through_the_yaml_file(tmp_path):
     assert [o.name for o in sc.static_obstacles] == ["back_wall", "top_wall", "bottom_wall"]
 
 
-@pytest.mark.skipif(not SHARED.is_file(), reason="shared DynaBARN worlds.json not present")
+@needs_dynabarn
 def test_every_shipped_world_converts_exactly_and_fits_the_arena(tmp_path):
     worlds = load_worlds(SHARED)
     assert len(worlds) == 60

@@ -19,6 +19,7 @@ import pytest
 
 from anyplan.geometry.se2 import dot2, dot2_rows, transform_points
 from tests.conftest import DYNABARN_WORLDS as _DYNABARN
+from tests.conftest import needs_dynabarn
 
 _RUN = """
 import hashlib, sys
@@ -45,7 +46,7 @@ def _digest(world: int, mode: str, seconds: float, coretype: str | None) -> str:
     return out.stdout.strip().splitlines()[-1]
 
 
-@pytest.mark.skipif(not _DYNABARN.is_file(), reason="shared DynaBARN worlds.json not present")
+@needs_dynabarn
 def test_a_tracked_run_is_the_same_with_another_machines_blas_kernels():
     # World 53, tracked, seed 0: its 30 s run gave three different trajectories under the
     # three kernels (this machine's, Prescott, Sandybridge) before the products were written out.
