@@ -29,6 +29,7 @@ Usage::
     python benchmarks/unknown.py [--only dynabarn,crowds,gaps,prediction] [--modes twist,tracked]
         [--planners st-bitstar,seq-bitstar,dovs,orca] [--worlds 20-59] [--windows 9] [--seeds 1]
         [--crowd-modes tracked,twist,oracle] [--sensor-noise M] [--sensor-rate HZ]
+        [--sensor-association named|anonymous] [--detection-prob P] [--clutter-rate N]
         [--actuation-noise SV,SW] [--localization-noise SXY,STH]
         [--jobs 2] [--set [PLANNER:]KEY=VALUE ...] [--deterministic]
         [--tracker KEY=VALUE ...]
@@ -60,7 +61,7 @@ if not SHARED.is_dir():
 
 
 def _run(task: tuple[str, dict[str, Any], str, str, int, dict[str, Any],
-                     tuple[tuple[str, float], ...], tuple[float | None, float | None],
+                     tuple[tuple[str, float], ...], tuple[Any, ...],
                      tuple[float, float, float, float]]
          ) -> dict[str, Any]:
     from anyplan.agents import make_agent
@@ -68,10 +69,14 @@ def _run(task: tuple[str, dict[str, Any], str, str, int, dict[str, Any],
     from anyplan.simulation.perception import override_sensing
     from anyplan.world.scenario import scenario_from_dict
 
-    suite, data, planner, mode, seed, config, tracker, (noise_m, rate_hz), (sv, sw, sxy, sth) = task
+    suite, data, planner, mode, seed, config, tracker, sensing, (sv, sw, sxy, sth) = task
+    noise_m, rate_hz, assoc, prob, clutter = sensing
     sc = scenario_from_dict(data, f"<{data['name']}>")
-    sc = override_sensing(sc, mode, noise_m if mode == "tracked" else None,
-                          rate_hz if mode == "tracked" else None)
+    tracked = mode == "tracked"
+    sc = override_sensing(sc, mode, noise_m if tracked else None, rate_hz if tracked else None,
+                          association=assoc if tracked else None,
+                          detection_prob=prob if tracked else None,
+                          clutter_rate=clutter if tracked else None)
     try:
         res = simulate(sc, make_agent(planner, **config), seed=seed,
                        config=SimConfig(tracker=tracker, actuation_sigma_v=sv, actuation_sigma_omega=sw,
@@ -253,6 +258,12 @@ def main(argv: list[str] | None = None) -> int:
                     help="detection noise [m] (sigma) of every tracked run (default: the scenario's)")
     ap.add_argument("--sensor-rate", type=float, default=None, metavar="HZ",
                     help="detection rate [Hz] of every tracked run (default: the scenario's)")
+    ap.add_argument("--sensor-association", default=None, metavar="KIND",
+                    help="named | anonymous detections in every tracked run (as anyplan run)")
+    ap.add_argument("--detection-prob", type=float, default=None, metavar="P",
+                    help="probability of detecting a visible obstacle per frame (as anyplan run)")
+    ap.add_argument("--clutter-rate", type=float, default=None, metavar="N",
+                    help="false detections per frame, anonymous only (as anyplan run)")
     from anyplan.cli.checks import actuation_noise, localization_noise
 
     ap.add_argument("--actuation-noise", type=actuation_noise, default=(0.0, 0.0), metavar="SV,SW",
@@ -279,14 +290,18 @@ def main(argv: list[str] | None = None) -> int:
     from anyplan.experiments.dynabarn import parse_worlds
     from anyplan.world.sensing import DEFAULT_NOISE_M, DEFAULT_RATE_HZ, SensingError, SensingSpec
 
-    sensing = (a.sensor_noise, a.sensor_rate)
+    sensing = (a.sensor_noise, a.sensor_rate, a.sensor_association, a.detection_prob,
+               a.clutter_rate)
     only = set(a.only.split(","))
     modes = a.modes.split(",")
     crowd_modes = a.crowd_modes.split(",")
-    try:  # the scenario schema's own checks of a mode, a noise and a rate, before any run
+    try:  # the scenario schema's own checks of every perception setting, before any run
         for m in modes + crowd_modes:
             SensingSpec(m, DEFAULT_NOISE_M if a.sensor_noise is None else a.sensor_noise,
-                        DEFAULT_RATE_HZ if a.sensor_rate is None else a.sensor_rate)
+                        DEFAULT_RATE_HZ if a.sensor_rate is None else a.sensor_rate,
+                        a.sensor_association or "named",
+                        1.0 if a.detection_prob is None else a.detection_prob,
+                        0.0 if a.clutter_rate is None else a.clutter_rate)
     except SensingError as exc:
         ap.error(str(exc))
     planners = []

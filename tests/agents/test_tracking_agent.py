@@ -65,9 +65,10 @@ def test_detection_leaving_the_tube_requests_a_replan():
     assert ag.tube_exits == 1
 
 
-def _drift_run(tube_cap_m: float, offset_m: float) -> tuple[Spy, TrackingAgent]:
+def _drift_run(tube_cap_m: float, offset_m: float, name: str | None = "a"
+               ) -> tuple[Spy, TrackingAgent]:
     """A track straight at 1 m/s along y = 1, planned against at 0.9 s, then detected at 2.0 s
-    ``offset_m`` [m] off its line (sideways: it has turned)."""
+    ``offset_m`` [m] off its line (sideways: it has turned); ``name=None``: anonymous."""
     spy = Spy()
     spy.plan_at = 10
     ag = TrackingAgent(spy, uncertainty=UncertaintyModel(tube_cap_m=tube_cap_m))
@@ -75,8 +76,8 @@ def _drift_run(tube_cap_m: float, offset_m: float) -> tuple[Spy, TrackingAgent]:
     robot = RobotState(1.0, 3.0, 0.0)
     for k in range(20):
         t = 0.1 * k
-        ag.act(Observation(t, robot, (), (Detection("a", t, t, 1.0, 0.3),)))
-    ag.act(Observation(2.0, robot, (), (Detection("a", 2.0, 2.0, 1.0 + offset_m, 0.3),)))
+        ag.act(Observation(t, robot, (), (Detection(name, t, t, 1.0, 0.3),)))
+    ag.act(Observation(2.0, robot, (), (Detection(name, 2.0, 2.0, 1.0 + offset_m, 0.3),)))
     return spy, ag
 
 
@@ -93,6 +94,15 @@ def test_the_replan_tube_is_capped_narrower_than_the_planned_disc():
     assert spy_wide.replans == [] and ag_wide.tube_exits == 0
     # and within the capped tube nothing is requested
     spy_in, _ = _drift_run(cap, cap + sigma3 - 0.05)
+    assert spy_in.replans == []
+
+
+def test_an_anonymous_detection_leaving_the_tube_requests_a_replan_under_its_tracks_name():
+    sigma3 = 3.0 * TrackerConfig().sigma_m
+    cap = UncertaintyModel().tube_cap_m
+    spy, ag = _drift_run(cap, cap + sigma3 + 0.05, name=None)
+    assert spy.replans == ["track-1 left its predicted tube"] and ag.tube_exits == 1
+    spy_in, _ = _drift_run(cap, cap + sigma3 - 0.05, name=None)
     assert spy_in.replans == []
 
 

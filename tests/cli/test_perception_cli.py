@@ -13,6 +13,11 @@ from anyplan.cli.main import main
     (["--perception", "radar"], "--perception: unknown perception mode 'radar'"),
     (["--perception", "tracked", "--sensor-noise", "-0.1"], "--sensor-noise: sensor noise must be >= 0"),
     (["--sensor-rate", "0"], "--sensor-rate: sensor rate must be > 0"),
+    (["--sensor-association", "guess"], "--sensor-association: unknown association 'guess'"),
+    (["--detection-prob", "0"], "--detection-prob: detection probability must be > 0"),
+    (["--clutter-rate", "1"], "--clutter-rate: false detections need association: anonymous"),
+    (["--sensor-association", "anonymous", "--clutter-rate", "-1"],
+     "--clutter-rate: clutter rate must be >= 0"),
 ])
 @pytest.mark.parametrize("command", ["run", "bench"])
 def test_bad_perception_options_exit_2_with_one_line(tmp_path, capsys, argv, words, command):
@@ -33,6 +38,18 @@ def test_run_records_the_perception_mode(tmp_path):
     p = json.loads((out / "result.json").read_text())["extra"]["perception"]
     assert p["mode"] == "tracked" and p["noise_m"] == 0.2 and p["rate_hz"] == 5.0
     assert p["frames"] == 15 and p["noise_seed"][0] == 0
+
+
+def test_run_records_anonymous_detections_and_clutter(tmp_path):
+    out = tmp_path / "r"
+    assert main(["run", "paper-1", "--planner", "straight", "--out", str(out), "--no-plot",
+                 "--perception", "tracked", "--sensor-association", "anonymous",
+                 "--detection-prob", "0.8", "--clutter-rate", "0.5", "--time-limit", "3"]) == 1
+    extra = json.loads((out / "result.json").read_text())["extra"]
+    p = extra["perception"]
+    assert (p["association"], p["detection_prob"], p["clutter_rate"]) == ("anonymous", 0.8, 0.5)
+    assert p["clutter_seed"][0] == 0 and p["false_detections"] > 0 and p["missed"] > 0
+    assert extra["tracking"]["started"] >= 1
 
 
 @pytest.mark.parametrize(("item", "words"), [

@@ -281,3 +281,116 @@ def test_a_bad_tracker_setting_names_the_field():
         SimConfig(tracker=(("ksigma", 1.0),))
     with pytest.raises(SettingError, match=r"UncertaintyModel\.cap_m: must be >= 0"):
         SimConfig(tracker=(("cap_m", -1.0),))
+
+
+def _anonymous(prob=1.0, clutter=0.0, sensing_range=None, **kw):
+    d = small_scenario_dict(**kw)
+    d["dynamic_obstacles"] = [
+        {"name": f"D{k}", "start": [1.5 + 1.5 * k, 0.5, 1.5708], "v": 0.2, "omega": 0.0,
+         "radius": 0.2 + 0.05 * k} for k in range(4)]
+    if sensing_range is not None:
+        d["robot"]["sensing_range"] = sensing_range
+    d["sensing"] = {"mode": "tracked", "association": "anonymous", "detection_prob": prob,
+                    "clutter_rate": clutter}
+    return scenario_from_dict(d)
+
+
+def test_anonymous_detections_carry_no_identity_and_come_in_the_order_of_x():
+    sc = _anonymous(static_obstacles=[])
+    s = Sensor(sc, sc.sensing, seed=1)
+    for i in range(20):
+        _, det = s.observe(0.1 * i, RobotState(1.0, 3.0, 0.0))
+        assert len(det) == 4 and all(d.name is None for d in det)
+        assert [d.x for d in det] == sorted(d.x for d in det)
+        assert sorted(d.radius for d in det) == pytest.approx([0.2, 0.25, 0.3, 0.35])
+
+
+def test_detection_probability_and_clutter_rate_hold_and_repeat():
+    p, rate, frames = 0.7, 1.5, 2000
+    sc = _anonymous(prob=p, clutter=rate, sensing_range=3.0)
+    robot = RobotState(4.0, 3.0, 0.0)
+    s = Sensor(sc, sc.sensing, seed=5)
+    real = false = visible = 0
+    for i in range(frames):
+        t = 0.1 * i
+        truth = [o.position(t) for o in sc.moving_obstacles if o.motion.exists(t)]
+        near = [q for q in truth if math.hypot(q[0] - 4.0, q[1] - 3.0) <= 3.0
+                and s.visible(robot, np.array([q]))[0]]
+        _, det = s.observe(t, robot)
+        visible += len(near)
+        for d in det:
+            # every detection is in range and in line of sight of the robot
+            assert math.hypot(d.x - 4.0, d.y - 3.0) <= 3.0 + 0.3
+            # a false detection has the median radius of the obstacles (0.275 m: none's)
+            is_real = abs(d.radius - s.clutter_radius) > 1e-9
+            if is_real:
+                assert any(math.hypot(d.x - q[0], d.y - q[1]) < 0.3 for q in near)
+            real += is_real
+            false += not is_real
+            if not is_real:
+                assert math.hypot(d.x - 4.0, d.y - 3.0) <= 3.0
+                assert s.visible(robot, np.array([[d.x, d.y]]))[0]
+                assert not (3.5 <= d.x <= 4.5 and 4.5 <= d.y <= 5.5)  # not inside S1
+    # binomial and Poisson counts within 5 standard deviations
+    assert abs(real - p * visible) < 5 * math.sqrt(visible * p * (1 - p)) + 2
+    assert abs(false - rate * frames) < 5 * math.sqrt(rate * frames) + 2
+    assert s.missed == visible - real and s.false_detections == false
+    rec = s.record()
+    assert rec["association"] == "anonymous" and rec["clutter_seed"] == [5, 0xC1A7]
+    # the same seed, the same frames
+    a, b = Sensor(sc, sc.sensing, seed=5), Sensor(sc, sc.sensing, seed=5)
+    for i in range(30):
+        assert a.observe(0.1 * i, robot) == b.observe(0.1 * i, robot)
+
+
+def test_named_detections_are_unchanged_by_the_new_settings():
+    sc = _tracked(static_obstacles=[])
+    assert (sc.sensing.association, sc.sensing.detection_prob, sc.sensing.clutter_rate) == \
+        ("named", 1.0, 0.0)
+    assert "association" not in sc.sensing.to_dict()
+    s = Sensor(sc, sc.sensing, seed=7)
+    assert "association" not in s.record()
+
+
+@pytest.mark.parametrize(("block", "field", "words"), [
+    ({"association": "guess"}, "sensing.association", "unknown association 'guess'"),
+    ({"detection_prob": 0.0}, "sensing.detection_prob", "> 0"),
+    ({"detection_prob": 1.5}, "sensing.detection_prob", "<= 1"),
+    ({"association": "anonymous", "clutter_rate": -1.0}, "sensing.clutter_rate", ">= 0"),
+    ({"clutter_rate": 2.0}, "sensing.clutter_rate", "association: anonymous"),
+])
+def test_bad_association_settings_name_the_field(block, field, words):
+    d = small_scenario_dict()
+    d["sensing"] = {"mode": "tracked", **block}
+    with pytest.raises(ScenarioError) as ei:
+        scenario_from_dict(d, "f.yaml")
+    assert ei.value.field == field and "f.yaml" in str(ei.value) and words in str(ei.value)
+
+
+def test_association_settings_round_trip_and_override():
+    sc = _anonymous(prob=0.9, clutter=0.5)
+    assert scenario_from_dict(sc.to_dict()).sensing == sc.sensing
+    t = override_sensing(scenario_from_dict(small_scenario_dict()), "tracked",
+                         association="anonymous", clutter_rate=2.0)
+    assert (t.sensing.association, t.sensing.clutter_rate, t.sensing.detection_prob) == \
+        ("anonymous", 2.0, 1.0)
+    with pytest.raises(ValueError, match="anonymous"):
+        override_sensing(t, association="named")  # clutter needs anonymous detections
+
+
+def test_a_run_with_anonymous_detections_and_clutter_tracks_and_repeats():
+    sc = _anonymous(prob=0.9, clutter=1.0, static_obstacles=[])
+    runs = []
+    for _ in range(2):
+        ag = Estimates()
+        res = simulate(sc, ag, seed=2, config=SimConfig(time_limit=4.0))
+        runs.append([(o.name, o.x, o.y) for ob in ag.log for o in ob.obstacles])
+        trk = res.extra["tracking"]
+        assert trk["tracks"] == 4 and trk["started"] >= 4 and trk["discarded"] >= 1
+        assert res.extra["perception"]["false_detections"] > 0
+    assert runs[0] == runs[1]
+    # the last frame's estimates: one per obstacle, each within 0.3 m of it
+    last = list(ag.log[-1].obstacles)
+    truth = [o.position(ag.log[-1].t) for o in sc.moving_obstacles]
+    assert len(last) == 4
+    assert all(min(math.hypot(o.x - q[0], o.y - q[1]) for o in last) < 0.3 for q in truth)

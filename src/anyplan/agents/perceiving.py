@@ -7,7 +7,8 @@ at every step it feeds the detections to an IMM tracker
 :class:`~anyplan.agents.base.Observation` whose obstacles are the tracks' estimates (pose and
 twist of the mean, no motion model) carrying the growth of their uncertain disc
 (:class:`~anyplan.prediction.uncertain.UncertaintyModel`). Tracks are kept in the robot's
-odometry frame (``Observation.odom``) whenever the localizer's pose differs from it. A detection
+odometry frame (``Observation.odom``) whenever the localizer's pose differs from it. Anonymous
+detections are associated by the tracker (a detection then bears its track's name). A detection
 that leaves the tube of the prediction the agent last planned against (its extra radius capped at
 ``UncertaintyModel.tube_cap_m``, plus 3 noise standard deviations) asks the agent to replan
 (``request_replan(reason)``). Both in ``docs/perception.md``, "The pipeline in ``tracked``
@@ -25,6 +26,7 @@ from anyplan.agents.base import Agent, AgentStats, Observation
 from anyplan.agents.stats import TrackerCounts
 from anyplan.geometry.se2 import carry
 from anyplan.prediction.base import ConstantTwistPredictor, ObstacleObservation, PredictedObstacle
+from anyplan.prediction.detection import Detection
 from anyplan.prediction.tracking import Tracker, TrackerConfig
 from anyplan.prediction.uncertain import UNCERTAINTY_SETTINGS, UncertaintyModel
 from anyplan.world.robot import Command
@@ -80,11 +82,11 @@ class TrackingAgent(Agent):
         out.update({name: float(getattr(self.uncertainty, name)) for name in UNCERTAINTY_SETTINGS})
         return out
 
-    def _check_tube(self, obs: Observation) -> str | None:
+    def _check_tube(self, detections: tuple[Detection, ...]) -> str | None:
         k = 3.0 * max(self.tracker_config.sigma_m, 1e-3)
         cap = self.uncertainty.tube_cap_m
-        for d in obs.detections:
-            p = self._tube.get(d.name)
+        for d in detections:
+            p = None if d.name is None else self._tube.get(d.name)
             if p is None:
                 continue
             c = p.positions(np.array([d.t]))[0]
@@ -100,11 +102,14 @@ class TrackingAgent(Agent):
         if odom is not None and dets:
             q = _moved(np.array([[d.x, d.y] for d in dets]), believed, odom)
             dets = tuple(replace(d, x=float(x), y=float(y)) for d, (x, y) in zip(dets, q, strict=True))
-        self.tracker.update(obs.t, dets)
+        labelled = self.tracker.update(obs.t, dets)
         seen = self.uncertainty.observations(self.tracker.estimates(obs.t))
         if odom is not None and seen:
             seen = _to_frame(seen, odom, believed)
-        left = self._check_tube(obs) if self._tube else None
+        # the tube is in the believed frame, as the detections given: named by their tracks
+        named = tuple(replace(d, name=lab.name) if d.name is None else d
+                      for d, lab in zip(obs.detections, labelled, strict=True))
+        left = self._check_tube(named) if self._tube else None
         if left is not None:
             self.tube_exits += 1
             self._tube = {}  # one request per plan
@@ -117,7 +122,8 @@ class TrackingAgent(Agent):
         if n != self._plans:
             self._plans = n
             self._tube = {p.name: p for p in self._predictor.predict(seen)}
-        counts = TrackerCounts(len(self.tracker), self.tracker.dropped, self.tube_exits)
+        tr = self.tracker
+        counts = TrackerCounts(len(tr), tr.dropped, self.tube_exits, tr.started, tr.discarded)
         st = self.inner.stats
         if st.record is not None:
             st.record.tracking = counts  # typed agents: the record has the slot

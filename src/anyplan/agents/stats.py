@@ -43,15 +43,22 @@ def improvement_calls(extra: dict[str, Any], n_calls: int) -> list[bool]:
 
 @dataclass
 class TrackerCounts:
-    """The perceiving wrapper's ``extra.tracking``: live tracks, dropped tracks, tube exits."""
+    """The perceiving wrapper's ``extra.tracking``: live (confirmed) tracks, dropped tracks,
+    tube exits, and with anonymous detections the tracks started and those discarded before
+    confirmation (``started``, ``discarded``: written when tracks were started)."""
 
     tracks: int = 0
     dropped: int = 0
     tube_exits: int = 0
+    started: int = 0
+    discarded: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         """The ``result.json`` form."""
-        return {"tracks": self.tracks, "dropped": self.dropped, "tube_exits": self.tube_exits}
+        out = {"tracks": self.tracks, "dropped": self.dropped, "tube_exits": self.tube_exits}
+        if self.started:
+            out.update(started=self.started, discarded=self.discarded)
+        return out
 
 
 @dataclass

@@ -7,16 +7,19 @@ from collections.abc import Sequence
 
 from anyplan.errors import UsageError
 from anyplan.world.scenario import Scenario
-from anyplan.world.sensing import DEFAULT_NOISE_M, DEFAULT_RATE_HZ, MODES
+from anyplan.world.sensing import ASSOCIATIONS, DEFAULT_NOISE_M, DEFAULT_RATE_HZ, MODES
 
 __all__ = ["add_perception_options", "apply_perception", "add_tracker_option", "tracker_settings"]
 
 #: :class:`~anyplan.world.sensing.SensingSpec` fields -> the flags that set them.
-_FLAGS = {"mode": "--perception", "noise_m": "--sensor-noise", "rate_hz": "--sensor-rate"}
+_FLAGS = {"mode": "--perception", "noise_m": "--sensor-noise", "rate_hz": "--sensor-rate",
+          "association": "--sensor-association", "detection_prob": "--detection-prob",
+          "clutter_rate": "--clutter-rate"}
 
 
 def add_perception_options(p: argparse.ArgumentParser) -> None:
-    """Add ``--perception``, ``--sensor-noise`` and ``--sensor-rate`` to ``p``."""
+    """Add ``--perception``, ``--sensor-noise``, ``--sensor-rate``, ``--sensor-association``,
+    ``--detection-prob`` and ``--clutter-rate`` to ``p``."""
     p.add_argument("--perception", default=None, metavar="MODE",
                    help=f"what the robot knows of the moving obstacles: {' | '.join(MODES)} "
                         "(default: the scenario's sensing block, else oracle; overrides it)")
@@ -26,6 +29,16 @@ def add_perception_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--sensor-rate", type=float, default=None, metavar="HZ",
                    help=f"tracked: detection rate [Hz] (default: the scenario's, else "
                         f"{DEFAULT_RATE_HZ:g})")
+    p.add_argument("--sensor-association", default=None, metavar="KIND",
+                   help=f"tracked: {' | '.join(ASSOCIATIONS)}: detections carry their obstacle's "
+                        "name, or no identity (the robot's tracker associates them) (default: "
+                        "the scenario's, else named)")
+    p.add_argument("--detection-prob", type=float, default=None, metavar="P",
+                   help="tracked: probability that a visible obstacle is detected in a frame, "
+                        "in (0, 1] (default: the scenario's, else 1)")
+    p.add_argument("--clutter-rate", type=float, default=None, metavar="N",
+                   help="tracked, anonymous: mean number of false detections per frame "
+                        "(default: the scenario's, else 0)")
 
 
 def apply_perception(command: str, scenarios: Sequence[Scenario],
@@ -33,12 +46,16 @@ def apply_perception(command: str, scenarios: Sequence[Scenario],
     """The scenarios with the command line's perception options applied.
 
     Raises:
-        UsageError: an unknown mode, a negative noise, a rate that is not > 0 (exit code 2).
+        UsageError: a bad setting (an unknown mode or association, a negative noise, a rate
+            that is not > 0, ...; exit code 2), naming its flag.
     """
     from anyplan.simulation.perception import override_sensing
 
     try:
-        return [override_sensing(sc, args.perception, args.sensor_noise, args.sensor_rate)
+        return [override_sensing(sc, args.perception, args.sensor_noise, args.sensor_rate,
+                                 association=args.sensor_association,
+                                 detection_prob=args.detection_prob,
+                                 clutter_rate=args.clutter_rate)
                 for sc in scenarios]
     except ValueError as exc:  # a SensingError names its field; the flag is told here
         opt = _FLAGS.get(getattr(exc, "field", ""), "--perception")

@@ -9,16 +9,18 @@ __all__ = ["Detection"]
 
 @dataclass(frozen=True)
 class Detection:
-    """A noisy position of a named obstacle (perfect association), with its disc radius.
+    """A noisy position of an obstacle, with its disc radius.
 
     Attributes:
-        name: Obstacle name (the association is given, as by a perfect tracker front end).
+        name: Obstacle name with ``named`` association (given, as by a perfect tracker front
+            end); None for an ``anonymous`` detection, which may also be a false one (clutter):
+            the tracker associates it (:class:`~anyplan.prediction.tracking.Tracker`).
         t: Time of the measurement [s].
         x, y: Measured centre [m] (the true centre plus sensor noise).
         radius: Disc radius [m] (a detector measures the extent of what it sees; given exactly).
     """
 
-    name: str
+    name: str | None
     t: float
     x: float
     y: float

@@ -1,22 +1,27 @@
 """Tracking moving obstacles from noisy position detections: an IMM of two Kalman filters.
 
-Each obstacle (by name: the association is given) has a state ``[x, y, vx, vy, omega]`` (m, m/s,
-rad/s) estimated by an interacting multiple model (Blom & Bar-Shalom, IEEE TAC 1988) of a
-constant-velocity (CV) and a coordinated-turn (CT, extended Kalman) filter that switch at
-``switch_rate`` [1/s]; measurements are positions with noise ``sigma_m`` [m] per axis. Tracks
-start at their first detection, coast while occluded and are dropped after ``drop_after_s``.
+Each obstacle has a state ``[x, y, vx, vy, omega]`` (m, m/s, rad/s) estimated by an interacting
+multiple model (Blom & Bar-Shalom, IEEE TAC 1988) of a constant-velocity (CV) and a
+coordinated-turn (CT, extended Kalman) filter that switch at ``switch_rate`` [1/s];
+measurements are positions with noise ``sigma_m`` [m] per axis. Named detections go to their
+obstacle's track; anonymous ones (no name, some false) are associated by global nearest
+neighbour within the gate (an optimal assignment on squared Mahalanobis distances), and a
+track they start is reported only once confirmed (``confirm_hits`` updates). Tracks start at
+their first detection, coast while occluded and are dropped after ``drop_after_s``.
 Everything is vectorised over tracks.
 
-The models and their noise terms: ``docs/perception.md``, "The IMM tracker".
+The models and their noise terms: ``docs/perception.md``, "The IMM tracker" and "Anonymous
+detections".
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
 from anyplan.config import setting, validate
 from anyplan.prediction.detection import Detection
@@ -51,6 +56,14 @@ class TrackerConfig:
             Kirubarajan 2001, section 11.2). 9.2 is the 99 % gate of 2 degrees of freedom.
         q_manoeuvre: That extra acceleration noise density [m^2/s^3] (0: never). 50 lets the
             velocity change by about 2.2 m/s (one sigma) in a 0.1 s frame.
+        confirm_hits: Anonymous detections: a track is reported (confirmed) once it has had
+            this many detections; a false detection rarely has a second one in its gate.
+        tentative_drop_s: Anonymous detections: a track not yet confirmed that is not
+            detected for this long [s] is dropped.
+        init_max_speed: Anonymous detections: a track not yet confirmed takes a detection
+            only within this speed [m/s] (plus 4 noise sigmas) of its last one: its velocity is
+            still a guess and its gate would be metres wide (two-point initiation with a
+            velocity gate, Blackman & Popoli 1999, section 6.3).
     """
 
     sigma_m: float = setting(0.05, lo=0.0, unit="m", doc="measurement noise per axis")
@@ -71,6 +84,12 @@ class TrackerConfig:
                                     doc="squared Mahalanobis distance that marks a manoeuvre")
     q_manoeuvre: float = setting(50.0, lo=0.0, unit="m^2/s^3",
                                  doc="acceleration noise added at a manoeuvre")
+    confirm_hits: float = setting(3.0, lo=1.0, hi=100.0, unit="",
+                                  doc="anonymous: detections that confirm a track")
+    tentative_drop_s: float = setting(0.3, lo=0.0, lo_open=True, unit="s",
+                                      doc="anonymous: an unconfirmed track unseen this long is dropped")
+    init_max_speed: float = setting(3.0, lo=0.0, lo_open=True, unit="m/s",
+                                    doc="anonymous: fastest an unconfirmed track may move")
 
     def __post_init__(self) -> None:
         validate(self)
@@ -81,7 +100,7 @@ class TrackEstimate:
     """One track at time ``t`` [s]: mean state, its covariance and the model probabilities.
 
     Attributes:
-        name: Obstacle name.
+        name: Obstacle name (``track-K`` for a track of anonymous detections).
         t: Time [s] of the estimate.
         state: ``[x, y, vx, vy, omega]`` (m, m/s, rad/s).
         cov: 5 x 5 covariance.
@@ -170,7 +189,7 @@ def _accel_q(T: np.ndarray, q: float) -> np.ndarray:
 
 
 class Tracker:
-    """IMM (CV + CT) tracks of named obstacles.
+    """IMM (CV + CT) tracks of obstacles, from named or anonymous detections.
 
     Args:
         config: Filter settings.
@@ -186,12 +205,17 @@ class Tracker:
         self.last_seen = np.zeros(0)  # time of the last detection [s]
         self.radius = np.zeros(0)
         self.n = np.zeros(0, dtype=int)
-        self.dropped = 0
+        self.confirmed = np.zeros(0, dtype=bool)  # reported by estimates()
+        self.last_z = np.zeros((0, 2))  # the last detection's position [m]
+        self.started = 0  # tracks started from anonymous detections (their names: track-K)
+        self.dropped = 0  # confirmed tracks dropped
+        self.discarded = 0  # tracks dropped before confirmation (anonymous: mostly clutter)
         self.restarted = 0  # tracks restarted at a detection outside their gate (jumps)
         self.manoeuvres = 0  # updates that got the manoeuvre noise
 
     def __len__(self) -> int:
-        return len(self.names)
+        """The number of confirmed tracks (every track of named detections)."""
+        return int(self.confirmed.sum())
 
     # --- filter steps ----------------------------------------------------------------------------
     def _predict(self, idx: np.ndarray, t: float) -> np.ndarray:
@@ -274,9 +298,12 @@ class Tracker:
         far = np.hypot(y[..., 0], y[..., 1]).min(axis=1) > cfg.gate_m
         return far & (md.min(axis=1) > cfg.gate_chi2)
 
-    def _add(self, d: Detection) -> None:
+    def _add(self, d: Detection, confirmed: bool) -> None:
         x, P = self._initial(d)
+        assert d.name is not None
         self.names.append(d.name)
+        self.confirmed = np.append(self.confirmed, confirmed)
+        self.last_z = np.concatenate([self.last_z, [[d.x, d.y]]])
         self.x = np.concatenate([self.x, np.broadcast_to(x, (1, 2, 5))])
         self.P = np.concatenate([self.P, np.broadcast_to(P, (1, 2, 5, 5))])
         self.mu = np.concatenate([self.mu, [[0.8, 0.2]]])
@@ -286,20 +313,71 @@ class Tracker:
         self.n = np.append(self.n, 1)
 
     def _drop(self, keep: np.ndarray) -> None:
-        self.dropped += int((~keep).sum())
+        self.dropped += int((~keep & self.confirmed).sum())
+        self.discarded += int((~keep & ~self.confirmed).sum())
         self.names = [n for n, k in zip(self.names, keep, strict=True) if k]
         self.x, self.P, self.mu = self.x[keep], self.P[keep], self.mu[keep]
         self.t, self.last_seen = self.t[keep], self.last_seen[keep]
         self.radius, self.n = self.radius[keep], self.n[keep]
+        self.confirmed, self.last_z = self.confirmed[keep], self.last_z[keep]
+
+    def _associate(self, t: float, dets: list[Detection], taken: set[int]
+                   ) -> tuple[list[tuple[int, int]], list[int]]:
+        """Global nearest neighbour of anonymous detections ``dets`` at ``t`` [s] to the tracks
+        not in ``taken``: ``(pairs (detection, track), unpaired detections)``. A pair is
+        admissible inside the gate the restart rule uses (within ``gate_m`` of the predicted
+        position or ``gate_chi2`` under a model), and for a track not yet confirmed within
+        ``init_max_speed`` of its last detection; among them the assignment minimising the sum
+        of squared Mahalanobis distances (the smaller of the two models'), with as many pairs
+        as possible (scipy's ``linear_sum_assignment``). The filter is not changed."""
+        cand = np.array([i for i in range(len(self.names)) if i not in taken], dtype=int)
+        if len(cand) == 0:
+            return [], list(range(len(dets)))
+        cfg = self.config
+        z = np.array([[d.x, d.y] for d in dets])
+        saved = (self.x.copy(), self.P.copy(), self.mu.copy(), self.t.copy())
+        self._predict(cand[self.t[cand] < t], t)
+        y = z[None, :, None, :] - self.x[cand][:, None, :, :2]           # (tracks, dets, 2, 2)
+        r2 = max(cfg.sigma_m, 1e-3) ** 2
+        Sinv, _ = _inv2(self.P[cand][:, :, :2, :2] + r2 * np.eye(2))     # (tracks, 2, 2, 2)
+        md = np.einsum("ndma,nmab,ndmb->ndm", y, Sinv, y).min(axis=2)
+        far = np.hypot(y[..., 0], y[..., 1]).min(axis=2) > cfg.gate_m
+        self.x, self.P, self.mu, self.t = saved
+        ok = ~(far & (md > cfg.gate_chi2))
+        young = ~self.confirmed[cand]
+        if young.any():
+            reach = cfg.init_max_speed * (t - self.last_seen[cand]) + 4.0 * max(cfg.sigma_m, 1e-3)
+            step = z[None, :, :] - self.last_z[cand][:, None, :]
+            ok &= ~young[:, None] | (np.hypot(step[..., 0], step[..., 1]) <= reach[:, None])
+        # an inadmissible pair costs more than all admissible ones together: the assignment
+        # first has as few of them as it can, then the least distance
+        big = 1.0 + float(np.where(ok, md, 0.0).sum()) * 2.0 + 1e6
+        rows, cols = linear_sum_assignment(np.where(ok, md, big))
+        pairs = [(int(c), int(cand[r])) for r, c in zip(rows, cols, strict=True) if ok[r, c]]
+        paired = {c for c, _ in pairs}
+        return pairs, [j for j in range(len(dets)) if j not in paired]
 
     # --- public ----------------------------------------------------------------------------------
-    def update(self, t: float, detections: Iterable[Detection]) -> None:
-        """One sensor frame at time ``t`` [s]: update the detected tracks, start new ones,
-        coast the others and drop those unseen for ``drop_after_s``."""
+    def update(self, t: float, detections: Iterable[Detection]) -> tuple[Detection, ...]:
+        """One sensor frame at time ``t`` [s]: associate the anonymous detections
+        (:meth:`_associate`), update the detected tracks, start new ones, coast the others and
+        drop those unseen for ``drop_after_s`` (``tentative_drop_s`` before confirmation).
+        Returns the detections, an anonymous one named after the track it updated or started."""
         dets = list(detections)
         index = {n: i for i, n in enumerate(self.names)}
-        upd = [(index[d.name], d) for d in dets if d.name in index]
-        new = [d for d in dets if d.name not in index]
+        upd = [(index[d.name], d) for d in dets if d.name is not None and d.name in index]
+        new = [(d, True) for d in dets if d.name is not None and d.name not in index]
+        labels = [d.name for d in dets]
+        anon = [k for k, d in enumerate(dets) if d.name is None]
+        if anon:
+            pairs, rest = self._associate(t, [dets[k] for k in anon], {i for i, _ in upd})
+            for j, i in pairs:
+                upd.append((i, dets[anon[j]]))
+                labels[anon[j]] = self.names[i]
+            for j in rest:
+                self.started += 1
+                labels[anon[j]] = f"track-{self.started}"
+                new.append((replace(dets[anon[j]], name=labels[anon[j]]), False))
         if upd:
             idx = np.array([i for i, _ in upd])
             steps = self._predict(idx, t)
@@ -320,18 +398,23 @@ class Tracker:
                     self.manoeuvres += int(man.sum())
                 self._update(ii, zz)
             self.last_seen[idx] = t
+            self.last_z[idx] = z
             self.n[idx] += 1
             self.radius[idx] = [d.radius for _, d in upd]
-        for d in new:
-            self._add(d)
-        keep = t - self.last_seen <= self.config.drop_after_s + 1e-9
+        for d, named in new:
+            self._add(d, named)
+        self.confirmed |= self.n >= round(self.config.confirm_hits)
+        patience = np.where(self.confirmed, self.config.drop_after_s, self.config.tentative_drop_s)
+        keep = t - self.last_seen <= patience + 1e-9
         if not keep.all():
             self._drop(keep)
+        return tuple(d if d.name is not None else replace(d, name=lab)
+                     for d, lab in zip(dets, labels, strict=True))
 
     def estimates(self, t: float) -> list[TrackEstimate]:
-        """Every track predicted to time ``t`` [s] (the filter itself is not changed): the IMM
-        combination of the models' means and covariances."""
-        if not self.names:
+        """Every confirmed track predicted to time ``t`` [s] (the filter itself is not
+        changed): the IMM combination of the models' means and covariances."""
+        if not self.confirmed.any():
             return []
         saved = (self.x.copy(), self.P.copy(), self.mu.copy(), self.t.copy())
         idx = np.flatnonzero(self.t < t)
@@ -342,6 +425,6 @@ class Tracker:
         Pm = np.einsum("nm,nmkl->nkl", mu, self.P) + np.einsum("nm,nmk,nml->nkl", mu, d, d)
         out = [TrackEstimate(n, t, xm[i], Pm[i], mu[i].copy(), float(self.radius[i]),
                              float(self.last_seen[i]), int(self.n[i]), self.x[i].copy())
-               for i, n in enumerate(self.names)]
+               for i, n in enumerate(self.names) if self.confirmed[i]]
         self.x, self.P, self.mu, self.t = saved
         return out

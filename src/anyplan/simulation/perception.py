@@ -5,7 +5,9 @@ model within ``robot.sensing_range``, the paper's assumption), ``twist`` (the sa
 motion model) and ``tracked`` (noisy position detections of the visible obstacles at the sensor
 rate). An obstacle is visible when its centre is in range and in line of sight past the static
 obstacles; it exists only within its motion's span. Noise comes from a Generator seeded with
-``(seed, NOISE_STREAM)``: the same seed, the same noise.
+``(seed, NOISE_STREAM)``: the same seed, the same noise. Anonymous detections (no names, in
+the order of their x), missed detections and false ones (clutter) draw from a second Generator,
+``(seed, CLUTTER_STREAM)``.
 
 Frames, visibility and seeding: ``docs/perception.md``, "Perception modes: what the sensor
 sees".
@@ -16,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import fields, replace
+from typing import Any
 
 import numpy as np
 
@@ -31,11 +34,17 @@ from anyplan.world.robot import RobotState
 from anyplan.world.scenario import Scenario
 from anyplan.world.sensing import SensingSpec
 
-__all__ = ["NOISE_STREAM", "Sensor", "observe_exact", "effective_sensing", "override_sensing",
-           "with_tracking", "tracking_setting_names", "tracking_configs", "parse_tracking_settings"]
+__all__ = ["NOISE_STREAM", "CLUTTER_STREAM", "Sensor", "observe_exact", "effective_sensing",
+           "override_sensing", "with_tracking", "tracking_setting_names", "tracking_configs",
+           "parse_tracking_settings"]
 
 #: Second entry of the noise generator's seed sequence ``(run seed, NOISE_STREAM)``.
 NOISE_STREAM = 0x5E45
+#: Second entry of the seed sequence of the missed and false detections.
+CLUTTER_STREAM = 0xC1A7
+#: Draws per false detection before one in the visible region is given up (a region that is
+#: nearly all hidden).
+_CLUTTER_TRIES = 50
 
 
 def observe_exact(scenario: Scenario, t: float, robot: RobotState,
@@ -60,7 +69,7 @@ def effective_sensing(scenario: Scenario, announce_motions: bool = True) -> Sens
     switch of :class:`~anyplan.simulation.simulator.SimConfig`) turns ``oracle`` into ``twist``."""
     spec = scenario.sensing or SensingSpec()
     if spec.mode == "oracle" and not announce_motions:
-        spec = SensingSpec("twist", spec.noise_m, spec.rate_hz)
+        spec = replace(spec, mode="twist")
     return spec
 
 
@@ -78,17 +87,31 @@ class Sensor:
         self.spec = spec
         self.seed_sequence = (int(seed), NOISE_STREAM)
         self.rng = np.random.default_rng(list(self.seed_sequence))
+        self.clutter_seed = (int(seed), CLUTTER_STREAM)
+        self.clutter_rng = np.random.default_rng(list(self.clutter_seed))
         self.occluders = ObstacleSet([o.shape for o in scenario.static_obstacles])
+        radii = [o.radius for o in scenario.moving_obstacles]
+        #: Radius [m] a false detection reports: the median of the moving obstacles'.
+        self.clutter_radius = float(np.median(radii)) if radii else 0.25
         self.period = 1.0 / spec.rate_hz
         self._frame = 0
         self.frames = 0
         self.detections = 0
+        self.missed = 0
+        self.false_detections = 0
 
     def record(self) -> dict[str, object]:
         """What to store in ``result.extra["perception"]``."""
-        return {"mode": self.spec.mode, "noise_m": self.spec.noise_m, "rate_hz": self.spec.rate_hz,
-                "noise_seed": list(self.seed_sequence), "frames": self.frames,
-                "detections": self.detections}
+        out: dict[str, object] = {
+            "mode": self.spec.mode, "noise_m": self.spec.noise_m, "rate_hz": self.spec.rate_hz,
+            "noise_seed": list(self.seed_sequence), "frames": self.frames,
+            "detections": self.detections}
+        sp = self.spec
+        if (sp.association, sp.detection_prob, sp.clutter_rate) != ("named", 1.0, 0.0):
+            out.update(association=sp.association, detection_prob=sp.detection_prob,
+                       clutter_rate=sp.clutter_rate, clutter_seed=list(self.clutter_seed),
+                       missed=self.missed, false_detections=self.false_detections)
+        return out
 
     def visible(self, robot: RobotState, centres: np.ndarray) -> np.ndarray:
         """Mask (N,): centres (N, 2) [m] in line of sight of the robot's centre (exact)."""
@@ -109,8 +132,9 @@ class Sensor:
         while self._frame * self.period <= t + 1e-9:
             self._frame += 1
         self.frames += 1
+        spec = self.spec
         movers = [o for o in self.scenario.moving_obstacles if o.motion.exists(t)]
-        if not movers:
+        if not movers and spec.clutter_rate == 0.0:
             return (), ()
         p = np.array([o.position(t) for o in movers]).reshape(-1, 2)
         keep = np.ones(len(movers), dtype=bool)
@@ -119,29 +143,67 @@ class Sensor:
             keep &= np.hypot(p[:, 0] - robot.x, p[:, 1] - robot.y) <= rng_limit
         idx = np.flatnonzero(keep)
         idx = idx[self.visible(robot, p[idx])]
-        noise = self.rng.normal(0.0, self.spec.noise_m, size=(len(idx), 2)) \
-            if self.spec.noise_m > 0.0 else np.zeros((len(idx), 2))
-        out = tuple(Detection(movers[i].name, t, float(p[i, 0] + e[0]), float(p[i, 1] + e[1]),
-                              movers[i].radius) for i, e in zip(idx, noise, strict=True))
+        if spec.detection_prob < 1.0 and len(idx):
+            hit = self.clutter_rng.random(len(idx)) < spec.detection_prob
+            self.missed += int((~hit).sum())
+            idx = idx[hit]
+        noise = self.rng.normal(0.0, spec.noise_m, size=(len(idx), 2)) \
+            if spec.noise_m > 0.0 else np.zeros((len(idx), 2))
+        named = spec.association == "named"
+        out = [Detection(movers[i].name if named else None, t, float(p[i, 0] + e[0]),
+                         float(p[i, 1] + e[1]), movers[i].radius)
+               for i, e in zip(idx, noise, strict=True)]
+        if spec.clutter_rate > 0.0:
+            false = self._clutter(robot)
+            self.false_detections += len(false)
+            out += [Detection(None, t, float(x), float(y), self.clutter_radius) for x, y in false]
+        if not named:  # no identity, not even the scenario's order
+            out.sort(key=lambda d: (d.x, d.y))
         self.detections += len(out)
-        return (), out
+        return (), tuple(out)
+
+    def _clutter(self, robot: RobotState) -> np.ndarray:
+        """This frame's false detections (K, 2) [m]: a Poisson number (mean ``clutter_rate``)
+        of points uniform over what the sensor sees: within ``robot.sensing_range`` of the
+        robot (the arena without one), inside the arena and in line of sight."""
+        rng, sc = self.clutter_rng, self.scenario
+        k = int(rng.poisson(self.spec.clutter_rate))
+        x0, y0 = sc.origin
+        x1, y1 = x0 + sc.width, y0 + sc.height
+        r = sc.robot.sensing_range
+        if r is not None:
+            x0, y0 = max(x0, robot.x - r), max(y0, robot.y - r)
+            x1, y1 = min(x1, robot.x + r), min(y1, robot.y + r)
+        out = []
+        for _ in range(k):
+            for _ in range(_CLUTTER_TRIES):
+                q = np.array([rng.uniform(x0, x1), rng.uniform(y0, y1)])
+                if r is not None and math.hypot(q[0] - robot.x, q[1] - robot.y) > r:
+                    continue
+                if self.visible(robot, q[None, :])[0]:
+                    out.append(q)
+                    break
+        return np.array(out).reshape(-1, 2)
 
 
 def override_sensing(scenario: Scenario, mode: str | None = None, noise_m: float | None = None,
-                     rate_hz: float | None = None) -> Scenario:
+                     rate_hz: float | None = None, *, association: str | None = None,
+                     detection_prob: float | None = None,
+                     clutter_rate: float | None = None) -> Scenario:
     """The scenario with its sensing settings overridden where given (None keeps the
     scenario's, or the defaults when it has no ``sensing:`` block).
 
     Raises:
-        ValueError: an unknown mode, a negative noise or a rate that is not > 0.
+        SensingError: a bad setting (:class:`~anyplan.world.sensing.SensingSpec`; its
+            ``field`` names it).
     """
-    if mode is None and noise_m is None and rate_hz is None:
+    given: dict[str, Any] = {
+        "mode": mode, "noise_m": noise_m, "rate_hz": rate_hz, "association": association,
+        "detection_prob": detection_prob, "clutter_rate": clutter_rate}
+    given = {k: (v if isinstance(v, str) else float(v)) for k, v in given.items() if v is not None}
+    if not given:
         return scenario
-    base = scenario.sensing or SensingSpec()
-    spec = SensingSpec(base.mode if mode is None else mode,
-                       base.noise_m if noise_m is None else float(noise_m),
-                       base.rate_hz if rate_hz is None else float(rate_hz))
-    return replace(scenario, sensing=spec)
+    return replace(scenario, sensing=replace(scenario.sensing or SensingSpec(), **given))
 
 
 def tracking_setting_names() -> tuple[str, ...]:

@@ -24,7 +24,7 @@ from anyplan.geometry.shapes import Circle, Polygon, Shape, rectangle
 from anyplan.registry import Registry
 from anyplan.world import limits as L
 from anyplan.world.motion import Motion, TrackMotion, UnicycleMotion, WaypointMotion
-from anyplan.world.sensing import SensingSpec
+from anyplan.world.sensing import MAX_CLUTTER_RATE, SensingError, SensingSpec
 
 __all__ = ["StaticObstacle", "MovingObstacle", "Ctx", "OBSTACLE_TYPES", "MOTION_TYPES",
            "parse_static", "parse_moving", "parse_sensing", "join_field", "typename"]
@@ -286,13 +286,19 @@ MOTION_TYPES.register("track", _parse_track)
 def parse_sensing(c: Ctx, obj: Any) -> SensingSpec:
     """The ``sensing:`` block."""
     m = c.mapping(obj, "sensing")
-    c.keys(m, "sensing", ("mode",), ("noise_m", "rate_hz"))
+    c.keys(m, "sensing", ("mode",), ("noise_m", "rate_hz", "association", "detection_prob",
+                                     "clutter_rate"))
     mode = c.string(m["mode"], "sensing.mode")
     noise = c.number(m.get("noise_m", SensingSpec.noise_m), "sensing.noise_m", nonneg=True,
                      hi=L.MAX_SIZE_M)
     rate = c.number(m.get("rate_hz", SensingSpec.rate_hz), "sensing.rate_hz", positive=True,
                     hi=L.MAX_SENSOR_RATE_HZ)
+    assoc = c.string(m.get("association", SensingSpec.association), "sensing.association")
+    prob = c.number(m.get("detection_prob", SensingSpec.detection_prob), "sensing.detection_prob",
+                    positive=True, hi=1.0)
+    clutter = c.number(m.get("clutter_rate", SensingSpec.clutter_rate), "sensing.clutter_rate",
+                       nonneg=True, hi=MAX_CLUTTER_RATE)
     try:
-        return SensingSpec(mode, noise, rate)
-    except ValueError as exc:
-        raise c.fail("sensing.mode", str(exc)) from None
+        return SensingSpec(mode, noise, rate, assoc, prob, clutter)
+    except SensingError as exc:
+        raise c.fail(f"sensing.{exc.field}", str(exc)) from None

@@ -7,7 +7,9 @@ Three modes (``docs/scenarios.md``, "Sensing"):
 * ``twist``: the current pose and twist, exact, and no future;
 * ``tracked``: noisy positions only (Gaussian, ``noise_m`` [m] standard deviation per axis), at
   ``rate_hz`` [Hz], within ``robot.sensing_range`` and in line of sight; each detection keeps
-  the obstacle's name (perfect association) and its radius, nothing else.
+  its radius and, with ``association: named`` (the default), the obstacle's name (perfect
+  association); ``anonymous`` detections carry no identity, a visible obstacle is detected with
+  probability ``detection_prob`` and ``clutter_rate`` false detections come per frame.
 
 The sensor itself lives in :mod:`anyplan.simulation.perception`; this module only holds the
 validated settings, so that the scenario loader can parse them.
@@ -20,10 +22,15 @@ from dataclasses import dataclass
 
 from anyplan.errors import AnyplanError
 
-__all__ = ["MODES", "SensingSpec", "SensingError", "DEFAULT_NOISE_M", "DEFAULT_RATE_HZ"]
+__all__ = ["MODES", "ASSOCIATIONS", "SensingSpec", "SensingError", "DEFAULT_NOISE_M",
+           "DEFAULT_RATE_HZ", "MAX_CLUTTER_RATE"]
 
 #: Known perception modes.
 MODES = ("oracle", "twist", "tracked")
+#: How ``tracked`` detections are told apart: by the obstacle's name, or not at all.
+ASSOCIATIONS = ("named", "anonymous")
+#: Largest mean number of false detections per frame.
+MAX_CLUTTER_RATE = 1000.0
 #: Default position noise [m] (standard deviation per axis) of ``tracked``.
 DEFAULT_NOISE_M = 0.05
 #: Default detection rate [Hz] of ``tracked``.
@@ -31,7 +38,8 @@ DEFAULT_RATE_HZ = 10.0
 
 
 class SensingError(AnyplanError, ValueError):
-    """A bad perception setting; ``field`` names it (``mode``, ``noise_m`` or ``rate_hz``)."""
+    """A bad perception setting; ``field`` names it (``mode``, ``noise_m``, ``rate_hz``,
+    ``association``, ``detection_prob`` or ``clutter_rate``)."""
 
     def __init__(self, field: str, message: str) -> None:
         self.field = field
@@ -46,14 +54,26 @@ class SensingSpec:
         mode: ``oracle``, ``twist`` or ``tracked``.
         noise_m: Standard deviation [m] of the detection noise on x and on y (``tracked``).
         rate_hz: Detection rate [Hz] (``tracked``).
+        association: ``named`` (each detection carries its obstacle's name: perfect
+            association) or ``anonymous`` (no identity: the robot's tracker associates them,
+            ``docs/perception.md``, "Anonymous detections") (``tracked``).
+        detection_prob: Probability that a visible obstacle is detected in a frame, in (0, 1]
+            (``tracked``).
+        clutter_rate: Mean number of false detections per frame (Poisson), >= 0; only with
+            ``anonymous`` association (a named detection is a real obstacle) (``tracked``).
 
     Raises:
-        SensingError: an unknown mode, a negative or non-finite noise, a rate that is not > 0.
+        SensingError: an unknown mode or association, a negative or non-finite noise, a rate
+            that is not > 0, a detection probability outside (0, 1], a negative clutter rate
+            or clutter with named detections.
     """
 
     mode: str = "oracle"
     noise_m: float = DEFAULT_NOISE_M
     rate_hz: float = DEFAULT_RATE_HZ
+    association: str = "named"
+    detection_prob: float = 1.0
+    clutter_rate: float = 0.0
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -66,7 +86,28 @@ class SensingSpec:
         if not (math.isfinite(self.rate_hz) and 0.0 < self.rate_hz <= MAX_SENSOR_RATE_HZ):
             raise SensingError("rate_hz", f"sensor rate must be > 0 Hz and <= {MAX_SENSOR_RATE_HZ:g} Hz, got "
                              f"{self.rate_hz:g}")
+        if self.association not in ASSOCIATIONS:
+            raise SensingError("association", f"unknown association '{self.association}' "
+                                              f"(known: {', '.join(ASSOCIATIONS)})")
+        if not (math.isfinite(self.detection_prob) and 0.0 < self.detection_prob <= 1.0):
+            raise SensingError("detection_prob", "detection probability must be > 0 and <= 1, "
+                                                 f"got {self.detection_prob:g}")
+        if not (math.isfinite(self.clutter_rate) and 0.0 <= self.clutter_rate <= MAX_CLUTTER_RATE):
+            raise SensingError("clutter_rate", "clutter rate must be >= 0 and <= "
+                                               f"{MAX_CLUTTER_RATE:g} per frame, got {self.clutter_rate:g}")
+        if self.clutter_rate > 0.0 and self.association != "anonymous":
+            raise SensingError("clutter_rate", "false detections need association: anonymous "
+                                               "(a named detection is a real obstacle)")
 
     def to_dict(self) -> dict[str, float | str]:
-        """The ``sensing:`` block of the YAML schema."""
-        return {"mode": self.mode, "noise_m": self.noise_m, "rate_hz": self.rate_hz}
+        """The ``sensing:`` block of the YAML schema (the association keys only when not their
+        defaults)."""
+        out: dict[str, float | str] = {"mode": self.mode, "noise_m": self.noise_m,
+                                       "rate_hz": self.rate_hz}
+        if self.association != "named":
+            out["association"] = self.association
+        if self.detection_prob != 1.0:
+            out["detection_prob"] = self.detection_prob
+        if self.clutter_rate != 0.0:
+            out["clutter_rate"] = self.clutter_rate
+        return out
