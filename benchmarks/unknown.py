@@ -26,7 +26,7 @@ timings from ``--jobs 1``.
 
 Usage::
 
-    python benchmarks/unknown.py [--only dynabarn,crowds,gaps,prediction] [--modes twist,tracked]
+    python benchmarks/unknown.py [--only dynabarn,crowds,gaps,prediction,tracking] [--modes twist,tracked]
         [--planners st-bitstar,seq-bitstar,dovs,orca] [--worlds 20-59] [--windows 9] [--seeds 1]
         [--crowd-modes tracked,twist,oracle] [--sensor-noise M] [--sensor-rate HZ]
         [--sensor-association named|anonymous] [--detection-prob P] [--clutter-rate N]
@@ -150,6 +150,30 @@ def _prediction(tracker: tuple[tuple[str, float], ...] = ()) -> str:
             lines.append(f"| {f} | {noise:g} | {r.samples} | {r.ade_cv:.3f} | {r.fde_cv:.3f} | "
                          f"{r.ade_imm:.3f} | {r.fde_imm:.3f} | {r.coverage:.3f} | {c[:5].mean():.3f} | "
                          f"{e[2]:.2f} / {e[4]:.2f} / {e[11]:.2f} |")
+    return "\n".join(lines)
+
+
+def _tracking(tracker: tuple[tuple[str, float], ...] = ()) -> str:
+    """CLEAR MOT scores of the tracker on the two recorded scenes (the first 300 s of each,
+    every person detected at 10 Hz with 5 cm noise, seed 0), named and anonymous detections,
+    with misses and false detections (``anyplan.experiments.tracking_eval``)."""
+    from anyplan.experiments.crowds import read_obsmat
+    from anyplan.experiments.tracking_eval import evaluate_tracking
+    from anyplan.simulation.perception import tracking_configs
+
+    tc, _ = tracking_configs(dict(tracker), 0.05)
+    rows = [("named", 1.0, 0.0), ("anonymous", 1.0, 0.0), ("anonymous", 0.9, 0.0),
+            ("anonymous", 0.9, 0.5), ("anonymous", 0.9, 2.0)]
+    lines = ["| scene | detections | detection prob. | false per frame | people-frames | missed | "
+             "false tracks | identity switches | MOTA | MOTP [m] | tracks started |",
+             "|" + "---|" * 11]
+    for f in ("eth_hotel", "ucy_zara01"):
+        tracks = read_obsmat(SHARED / "crowds" / f"{f}_obsmat.txt")
+        for assoc, prob, clutter in rows:
+            r = evaluate_tracking(tracks, association=assoc, detection_prob=prob,
+                                  clutter_rate=clutter, tracker=tc, t_end=300.0)
+            lines.append(f"| {f} | {assoc} | {prob:g} | {clutter:g} | {r.gt} | {r.fn} | {r.fp} | "
+                         f"{r.id_switches} | {r.mota:.3f} | {r.motp_m:.3f} | {r.started} |")
     return "\n".join(lines)
 
 
@@ -325,6 +349,9 @@ def main(argv: list[str] | None = None) -> int:
                    "## Prediction of DynaBARN's obstacles (5 cm, 10 Hz)", "",
                    _prediction_dynabarn(parse_worlds(a.worlds), tracker), ""]
         print("\n".join(report), flush=True)
+    if "tracking" in only:
+        report += ["## Tracking quality on ETH/UCY (CLEAR MOT)", "", _tracking(tracker), ""]
+        print("\n".join(report[-4:]), flush=True)
     tasks = []
     seeds = range(a.first_seed, a.first_seed + a.seeds)
     errors = (*a.actuation_noise, *a.localization_noise)

@@ -5,8 +5,9 @@ multiple model (Blom & Bar-Shalom, IEEE TAC 1988) of a constant-velocity (CV) an
 coordinated-turn (CT, extended Kalman) filter that switch at ``switch_rate`` [1/s];
 measurements are positions with noise ``sigma_m`` [m] per axis. Named detections go to their
 obstacle's track; anonymous ones (no name, some false) are associated by global nearest
-neighbour within the gate (an optimal assignment on squared Mahalanobis distances), and a
-track they start is reported only once confirmed (``confirm_hits`` updates). Tracks start at
+neighbour within the gate (optimal assignments on the innovations' likelihood, established
+tracks first), and a track they start is reported only once confirmed (``confirm_hits``
+updates). Tracks start at
 their first detection, coast while occluded and are dropped after ``drop_after_s``.
 Everything is vectorised over tracks.
 
@@ -46,7 +47,8 @@ class TrackerConfig:
         drop_after_s: A track not detected for this long [s] is dropped.
         gate_m: A detection farther than this [m] from its track's predicted position, and
             outside its ``gate_chi2`` gate under every model, restarts the track there (the
-            obstacle jumped: a teleport is a leave and a new appearance, not a fast motion).
+            obstacle jumped: a teleport is a leave and a new appearance, not a fast motion); an
+            anonymous detection is associated only within it.
         gate_chi2: Squared Mahalanobis distance of that gate (2 degrees of freedom).
         manoeuvre_chi2: A detection inside the gate whose squared Mahalanobis distance
             exceeds this under every model marks a manoeuvre (an obstacle that turns back at a
@@ -325,11 +327,15 @@ class Tracker:
                    ) -> tuple[list[tuple[int, int]], list[int]]:
         """Global nearest neighbour of anonymous detections ``dets`` at ``t`` [s] to the tracks
         not in ``taken``: ``(pairs (detection, track), unpaired detections)``. A pair is
-        admissible inside the gate the restart rule uses (within ``gate_m`` of the predicted
-        position or ``gate_chi2`` under a model), and for a track not yet confirmed within
-        ``init_max_speed`` of its last detection; among them the assignment minimising the sum
-        of squared Mahalanobis distances (the smaller of the two models'), with as many pairs
-        as possible (scipy's ``linear_sum_assignment``). The filter is not changed."""
+        admissible within ``gate_m`` of the track's predicted position (under one of the
+        models: a reversal at a corner stays in it; the covariance's gate would grow metres
+        wide while a track coasts, and clutter would keep it alive), and for a track not yet
+        confirmed within ``init_max_speed`` of its last detection. The confirmed tracks are
+        assigned first, the others then to the detections left (a matching cascade: a young track's wide
+        covariance must not win a detection from an established one); each step takes the
+        assignment with the most admissible pairs and then the least cost, the negative log
+        likelihood ``d2 + ln det S`` (the smaller of the two models') (scipy's
+        ``linear_sum_assignment``). The filter is not changed."""
         cand = np.array([i for i in range(len(self.names)) if i not in taken], dtype=int)
         if len(cand) == 0:
             return [], list(range(len(dets)))
@@ -339,23 +345,37 @@ class Tracker:
         self._predict(cand[self.t[cand] < t], t)
         y = z[None, :, None, :] - self.x[cand][:, None, :, :2]           # (tracks, dets, 2, 2)
         r2 = max(cfg.sigma_m, 1e-3) ** 2
-        Sinv, _ = _inv2(self.P[cand][:, :, :2, :2] + r2 * np.eye(2))     # (tracks, 2, 2, 2)
-        md = np.einsum("ndma,nmab,ndmb->ndm", y, Sinv, y).min(axis=2)
-        far = np.hypot(y[..., 0], y[..., 1]).min(axis=2) > cfg.gate_m
+        Sinv, det = _inv2(self.P[cand][:, :, :2, :2] + r2 * np.eye(2))   # (tracks, 2, 2, 2)
+        d2 = np.einsum("ndma,nmab,ndmb->ndm", y, Sinv, y)
+        cost = (d2 + np.log(det)[:, None, :]).min(axis=2)
+        ok = np.hypot(y[..., 0], y[..., 1]).min(axis=2) <= cfg.gate_m
         self.x, self.P, self.mu, self.t = saved
-        ok = ~(far & (md > cfg.gate_chi2))
         young = ~self.confirmed[cand]
         if young.any():
             reach = cfg.init_max_speed * (t - self.last_seen[cand]) + 4.0 * max(cfg.sigma_m, 1e-3)
             step = z[None, :, :] - self.last_z[cand][:, None, :]
             ok &= ~young[:, None] | (np.hypot(step[..., 0], step[..., 1]) <= reach[:, None])
-        # an inadmissible pair costs more than all admissible ones together: the assignment
-        # first has as few of them as it can, then the least distance
-        big = 1.0 + float(np.where(ok, md, 0.0).sum()) * 2.0 + 1e6
-        rows, cols = linear_sum_assignment(np.where(ok, md, big))
-        pairs = [(int(c), int(cand[r])) for r, c in zip(rows, cols, strict=True) if ok[r, c]]
-        paired = {c for c, _ in pairs}
-        return pairs, [j for j in range(len(dets)) if j not in paired]
+        pairs: list[tuple[int, int]] = []
+        free = np.ones(len(dets), dtype=bool)
+        for stage in (~young, young):
+            rows = np.flatnonzero(stage)
+            cols = np.flatnonzero(free)
+            if not len(rows) or not len(cols):
+                continue
+            sub_ok = ok[np.ix_(rows, cols)]
+            if not sub_ok.any():
+                continue
+            sub = cost[np.ix_(rows, cols)]
+            # an inadmissible pair costs more than all admissible ones together: the
+            # assignment first has as few of them as it can, then the least cost
+            lo = float(sub[sub_ok].min())
+            big = 1.0 + float((sub[sub_ok] - lo).sum()) * 2.0 + 1e6
+            r, c = linear_sum_assignment(np.where(sub_ok, sub - lo, big))
+            for a, b in zip(r, c, strict=True):
+                if sub_ok[a, b]:
+                    pairs.append((int(cols[b]), int(cand[rows[a]])))
+                    free[cols[b]] = False
+        return pairs, [j for j in range(len(dets)) if free[j]]
 
     # --- public ----------------------------------------------------------------------------------
     def update(self, t: float, detections: Iterable[Detection]) -> tuple[Detection, ...]:
