@@ -24,10 +24,14 @@ def test_exact_detections_give_exact_counts():
     # 41 frames at 10 Hz, both people present in each: everyone matched, nothing else
     assert (named.frames, named.gt, named.tp, named.fn, named.fp) == (41, 82, 82, 0, 0)
     assert named.id_switches == 0 and named.mota == 1.0 and named.motp_m < 1e-6
-    anon = evaluate_tracking(tracks, association="anonymous", noise_m=0.0, tracker=tc)
-    # a track is reported from its third detection: two misses per person, then all matched
-    assert (anon.tp, anon.fn, anon.fp, anon.id_switches) == (78, 4, 0, 0)
-    assert anon.mota == pytest.approx(1.0 - 4 / 82) and anon.started == 2
+    for hits in (2, 3):
+        anon = evaluate_tracking(tracks, association="anonymous", noise_m=0.0,
+                                 tracker=TrackerConfig(sigma_m=0.001, drop_after_s=0.05,
+                                                       confirm_hits=hits))
+        # a track is reported from its confirming detection: hits - 1 misses per person
+        miss = 2 * (hits - 1)
+        assert (anon.tp, anon.fn, anon.fp, anon.id_switches) == (82 - miss, miss, 0, 0)
+        assert anon.mota == pytest.approx(1.0 - miss / 82) and anon.started == 2
 
 
 def test_clutter_and_misses_cost_what_the_counts_say_and_repeat():

@@ -88,19 +88,23 @@ def test_clutter_rarely_becomes_a_track_and_real_obstacles_are_confirmed_fast():
     # 1 false detection per frame over a 20 m x 20 m area, three walkers, 30 s at 10 Hz
     paths = {"A": lambda t: (-8.0 + 0.5 * t, 2.0), "B": lambda t: (8.0 - 0.5 * t, -2.0),
              "C": lambda t: (0.0, 1.0)}
+    hits = round(TrackerConfig().confirm_hits)
     tr = Tracker()
-    false_tracks = set()
+    false_frames: dict[str, int] = {}
     for t, dets, truth in _frames(paths, t_end=30.0, clutter=1.0):
         tr.update(t, dets)
         est = tr.estimates(t)
-        if t >= 0.25:  # the third frame: every walker confirmed
+        if t >= 0.1 * (hits - 1) - 1e-9:  # every walker confirmed at its confirming detection
             near = _nearest(est, truth)
             assert {n for n, d in near.values() if d < 0.3} == set(truth)
-        false_tracks |= {e.name for e in est if min(np.hypot(*(p - e.state[:2]))
-                                                     for p in truth.values()) > 1.0}
+        for e in est:
+            if min(np.hypot(*(p - e.state[:2])) for p in truth.values()) > 1.0:
+                false_frames[e.name] = false_frames.get(e.name, 0) + 1
     # a clutter point starts a track whose next detection must lie within 3 m/s x 0.1 s
-    # (+ 4 sigma) of it: about 0.16 % of the 400 m^2 per frame, twice in a row ~3e-6
-    assert len(false_tracks) == 0
+    # (+ 4 sigma) of it: 0.79 m^2 of the 400, about 0.2 % a frame, 0.6 expected in 300 frames
+    assert len(false_frames) <= 5
+    # ... and one confirmed by chance has earned little patience: gone within 0.4 s
+    assert all(n <= 4 for n in false_frames.values())
     assert tr.started > 250  # the clutter did start (tentative) tracks
 
 

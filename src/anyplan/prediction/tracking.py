@@ -7,7 +7,7 @@ measurements are positions with noise ``sigma_m`` [m] per axis. Named detections
 obstacle's track; anonymous ones (no name, some false) are associated by global nearest
 neighbour within the gate (optimal assignments on the innovations' likelihood, established
 tracks first), and a track they start is reported only once confirmed (``confirm_hits``
-updates). Tracks start at
+updates) and kept unseen as long as its detections have earned. Tracks start at
 their first detection, coast while occluded and are dropped after ``drop_after_s``.
 Everything is vectorised over tracks.
 
@@ -60,8 +60,10 @@ class TrackerConfig:
             velocity change by about 2.2 m/s (one sigma) in a 0.1 s frame.
         confirm_hits: Anonymous detections: a track is reported (confirmed) once it has had
             this many detections; a false detection rarely has a second one in its gate.
-        tentative_drop_s: Anonymous detections: a track not yet confirmed that is not
-            detected for this long [s] is dropped.
+        tentative_drop_s: Anonymous detections: a track is dropped when not detected for
+            ``tentative_drop_s`` x (its detections / ``confirm_hits``) [s], at least this and
+            at most ``drop_after_s`` (a track earns its patience: a false one confirmed by
+            chance is dropped about as fast as an unconfirmed one).
         init_max_speed: Anonymous detections: a track not yet confirmed takes a detection
             only within this speed [m/s] (plus 4 noise sigmas) of its last one: its velocity is
             still a guess and its gate would be metres wide (two-point initiation with a
@@ -86,10 +88,10 @@ class TrackerConfig:
                                     doc="squared Mahalanobis distance that marks a manoeuvre")
     q_manoeuvre: float = setting(50.0, lo=0.0, unit="m^2/s^3",
                                  doc="acceleration noise added at a manoeuvre")
-    confirm_hits: float = setting(3.0, lo=1.0, hi=100.0, unit="",
+    confirm_hits: float = setting(2.0, lo=1.0, hi=100.0, unit="",
                                   doc="anonymous: detections that confirm a track")
     tentative_drop_s: float = setting(0.3, lo=0.0, lo_open=True, unit="s",
-                                      doc="anonymous: an unconfirmed track unseen this long is dropped")
+                                      doc="anonymous: patience per confirm_hits detections")
     init_max_speed: float = setting(3.0, lo=0.0, lo_open=True, unit="m/s",
                                     doc="anonymous: fastest an unconfirmed track may move")
 
@@ -209,6 +211,7 @@ class Tracker:
         self.n = np.zeros(0, dtype=int)
         self.confirmed = np.zeros(0, dtype=bool)  # reported by estimates()
         self.last_z = np.zeros((0, 2))  # the last detection's position [m]
+        self.born_named = np.zeros(0, dtype=bool)  # started by a named detection
         self.started = 0  # tracks started from anonymous detections (their names: track-K)
         self.dropped = 0  # confirmed tracks dropped
         self.discarded = 0  # tracks dropped before confirmation (anonymous: mostly clutter)
@@ -305,6 +308,7 @@ class Tracker:
         assert d.name is not None
         self.names.append(d.name)
         self.confirmed = np.append(self.confirmed, confirmed)
+        self.born_named = np.append(self.born_named, confirmed)
         self.last_z = np.concatenate([self.last_z, [[d.x, d.y]]])
         self.x = np.concatenate([self.x, np.broadcast_to(x, (1, 2, 5))])
         self.P = np.concatenate([self.P, np.broadcast_to(P, (1, 2, 5, 5))])
@@ -322,6 +326,7 @@ class Tracker:
         self.t, self.last_seen = self.t[keep], self.last_seen[keep]
         self.radius, self.n = self.radius[keep], self.n[keep]
         self.confirmed, self.last_z = self.confirmed[keep], self.last_z[keep]
+        self.born_named = self.born_named[keep]
 
     def _associate(self, t: float, dets: list[Detection], taken: set[int]
                    ) -> tuple[list[tuple[int, int]], list[int]]:
@@ -381,7 +386,8 @@ class Tracker:
     def update(self, t: float, detections: Iterable[Detection]) -> tuple[Detection, ...]:
         """One sensor frame at time ``t`` [s]: associate the anonymous detections
         (:meth:`_associate`), update the detected tracks, start new ones, coast the others and
-        drop those unseen for ``drop_after_s`` (``tentative_drop_s`` before confirmation).
+        drop those unseen for ``drop_after_s`` (anonymous ones: the patience they earned,
+        ``tentative_drop_s``).
         Returns the detections, an anonymous one named after the track it updated or started."""
         dets = list(detections)
         index = {n: i for i, n in enumerate(self.names)}
@@ -424,7 +430,12 @@ class Tracker:
         for d, named in new:
             self._add(d, named)
         self.confirmed |= self.n >= round(self.config.confirm_hits)
-        patience = np.where(self.confirmed, self.config.drop_after_s, self.config.tentative_drop_s)
+        cfg = self.config
+        # anonymous tracks earn their patience: tentative_drop_s per confirm_hits detections,
+        # up to drop_after_s (a false track confirmed by chance dies as fast as a young one)
+        earned = np.clip(cfg.tentative_drop_s * self.n / round(cfg.confirm_hits),
+                         cfg.tentative_drop_s, cfg.drop_after_s)
+        patience = np.where(self.born_named, cfg.drop_after_s, earned)
         keep = t - self.last_seen <= patience + 1e-9
         if not keep.all():
             self._drop(keep)
