@@ -169,3 +169,24 @@ def test_the_odometry_pose_is_the_true_pose_with_an_exact_drive():
         assert exact.odom == exact.state  # the same integration, bit for bit
     # with an execution error odometry integrates the drive's twist, not the ground's: it drifts
     assert 0.0 < np.hypot(slip.odom.x - slip.state.x, slip.odom.y - slip.state.y) < 0.5
+
+
+def test_a_young_anonymous_track_near_the_robot_is_shown_at_once():
+    spy = Spy()
+    ag = TrackingAgent(spy)
+    ag.reset(scenario_from_dict(small_scenario_dict()), np.random.default_rng(0))
+    robot = RobotState(1.0, 3.0, 0.0)  # radius 0.3 m
+    near, far = (1.0 + 0.3 + 0.8, 3.0), (4.0, 3.0)  # gaps 0.8 m and 2.7 m
+    ag.act(Observation(0.0, robot, (), (Detection(None, 0.0, *near, 0.3),
+                                        Detection(None, 0.0, *far, 0.3))))
+    first = {(round(o.x, 3), round(o.y, 3)) for o in spy.log[-1].obstacles}
+    assert first == {near}  # the near one at its first detection, the far one not yet
+    ag.act(Observation(0.1, robot, (), (Detection(None, 0.1, *near, 0.3),
+                                        Detection(None, 0.1, *far, 0.3))))
+    assert len(spy.log[-1].obstacles) == 2  # confirmed at the second detection
+    # with urgent_gap_m = 0 the near one waits for its confirmation too
+    spy0 = Spy()
+    ag0 = TrackingAgent(spy0, tracker=TrackerConfig(urgent_gap_m=0.0))
+    ag0.reset(scenario_from_dict(small_scenario_dict()), np.random.default_rng(0))
+    ag0.act(Observation(0.0, robot, (), (Detection(None, 0.0, *near, 0.3),)))
+    assert spy0.log[-1].obstacles == ()

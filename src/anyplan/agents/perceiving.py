@@ -8,7 +8,8 @@ at every step it feeds the detections to an IMM tracker
 twist of the mean, no motion model) carrying the growth of their uncertain disc
 (:class:`~anyplan.prediction.uncertain.UncertaintyModel`). Tracks are kept in the robot's
 odometry frame (``Observation.odom``) whenever the localizer's pose differs from it. Anonymous
-detections are associated by the tracker (a detection then bears its track's name). A detection
+detections are associated by the tracker (a detection then bears its track's name; a young
+track near the robot is shown at once, ``TrackerConfig.urgent_gap_m``). A detection
 that leaves the tube of the prediction the agent last planned against (its extra radius capped at
 ``UncertaintyModel.tube_cap_m``, plus 3 noise standard deviations) asks the agent to replan
 (``request_replan(reason)``). Both in ``docs/perception.md``, "The pipeline in ``tracked``
@@ -46,6 +47,7 @@ class TrackingAgent(Agent):
 
     def __init__(self, inner: Agent, tracker: TrackerConfig | None = None,
                  uncertainty: UncertaintyModel | None = None) -> None:
+        self._radius = 0.0  # the robot's [m]
         self.inner = inner
         self.tracker_config = tracker or TrackerConfig()
         self.uncertainty = uncertainty or UncertaintyModel()
@@ -68,6 +70,7 @@ class TrackingAgent(Agent):
 
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
         self.inner.reset(scenario, rng)
+        self._radius = scenario.robot.radius
         self.tracker = Tracker(self.tracker_config)
         self._tube = {}
         self._plans = 0
@@ -103,7 +106,14 @@ class TrackingAgent(Agent):
             q = _moved(np.array([[d.x, d.y] for d in dets]), believed, odom)
             dets = tuple(replace(d, x=float(x), y=float(y)) for d, (x, y) in zip(dets, q, strict=True))
         labelled = self.tracker.update(obs.t, dets)
-        seen = self.uncertainty.observations(self.tracker.estimates(obs.t))
+        near = None
+        gap = self.tracker_config.urgent_gap_m
+        if gap > 0.0 and self.tracker.started:
+            # young anonymous tracks this close to the robot's disc are shown at once (in the
+            # tracker's frame: the odometry pose when it differs)
+            c = (r.x, r.y) if odom is None else (odom[0], odom[1])
+            near = (c[0], c[1], self._radius + gap)
+        seen = self.uncertainty.observations(self.tracker.estimates(obs.t, near))
         if odom is not None and seen:
             seen = _to_frame(seen, odom, believed)
         # the tube is in the believed frame, as the detections given: named by their tracks

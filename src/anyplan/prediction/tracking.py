@@ -64,6 +64,10 @@ class TrackerConfig:
             ``tentative_drop_s`` x (its detections / ``confirm_hits``) [s], at least this and
             at most ``drop_after_s`` (a track earns its patience: a false one confirmed by
             chance is dropped about as fast as an unconfirmed one).
+        urgent_gap_m: Anonymous detections: a track not yet confirmed whose last detection
+            is within this gap [m] of the robot's disc is shown to the planner at once
+            (``TrackingAgent``; 0: never): near the robot a false track costs a brake, a person
+            shown a frame late a collision.
         init_max_speed: Anonymous detections: a track not yet confirmed takes a detection
             only within this speed [m/s] (plus 4 noise sigmas) of its last one: its velocity is
             still a guess and its gate would be metres wide (two-point initiation with a
@@ -92,6 +96,8 @@ class TrackerConfig:
                                   doc="anonymous: detections that confirm a track")
     tentative_drop_s: float = setting(0.3, lo=0.0, lo_open=True, unit="s",
                                       doc="anonymous: patience per confirm_hits detections")
+    urgent_gap_m: float = setting(1.0, lo=0.0, unit="m",
+                                  doc="anonymous: young tracks this near the robot are shown")
     init_max_speed: float = setting(3.0, lo=0.0, lo_open=True, unit="m/s",
                                     doc="anonymous: fastest an unconfirmed track may move")
 
@@ -442,10 +448,18 @@ class Tracker:
         return tuple(d if d.name is not None else replace(d, name=lab)
                      for d, lab in zip(dets, labels, strict=True))
 
-    def estimates(self, t: float) -> list[TrackEstimate]:
+    def estimates(self, t: float, near: tuple[float, float, float] | None = None
+                  ) -> list[TrackEstimate]:
         """Every confirmed track predicted to time ``t`` [s] (the filter itself is not
-        changed): the IMM combination of the models' means and covariances."""
-        if not self.confirmed.any():
+        changed): the IMM combination of the models' means and covariances. ``near`` = (x, y,
+        r) [m]: also the tracks not yet confirmed whose last detection lies within r of (x,
+        y) (what is close to a robot is reported at once: a false one costs a brake, a person
+        missed a collision)."""
+        shown = self.confirmed
+        if near is not None and len(self.names):
+            d = np.hypot(self.last_z[:, 0] - near[0], self.last_z[:, 1] - near[1])
+            shown = shown | (d <= near[2])
+        if not shown.any():
             return []
         saved = (self.x.copy(), self.P.copy(), self.mu.copy(), self.t.copy())
         idx = np.flatnonzero(self.t < t)
@@ -456,6 +470,6 @@ class Tracker:
         Pm = np.einsum("nm,nmkl->nkl", mu, self.P) + np.einsum("nm,nmk,nml->nkl", mu, d, d)
         out = [TrackEstimate(n, t, xm[i], Pm[i], mu[i].copy(), float(self.radius[i]),
                              float(self.last_seen[i]), int(self.n[i]), self.x[i].copy())
-               for i, n in enumerate(self.names) if self.confirmed[i]]
+               for i, n in enumerate(self.names) if shown[i]]
         self.x, self.P, self.mu, self.t = saved
         return out
