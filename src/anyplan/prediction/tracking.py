@@ -264,12 +264,28 @@ class Tracker:
         self.t[idx] = t
         return T
 
+    def _r2(self) -> float:
+        """Measurement variance [m^2] per axis (``sigma_m`` floored at 1 mm)."""
+        return max(self.config.sigma_m, 1e-3) ** 2
+
+    def _innovation_cov(self, P: np.ndarray) -> np.ndarray:
+        """Innovation covariances S (..., 2, 2) of state covariances P (..., 5, 5)."""
+        return P[..., :2, :2] + self._r2() * np.eye(2)
+
     def _innovation(self, x: np.ndarray, P: np.ndarray, z: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
         """Innovations y (N, 2 models, 2) of positions z (N, 2) against states x (N, 2, 5) with
         covariances P (N, 2, 5, 5), and their covariances S (N, 2, 2, 2)."""
-        r2 = max(self.config.sigma_m, 1e-3) ** 2
-        return z[:, None, :] - x[:, :, :2], P[:, :, :2, :2] + r2 * np.eye(2)
+        return z[:, None, :] - x[:, :, :2], self._innovation_cov(P)
+
+    def _predicted(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Every track's model states (N, 2, 5), covariances (N, 2, 5, 5) and model
+        probabilities (N, 2) predicted to time ``t`` [s]; the filter itself is not changed."""
+        saved = (self.x.copy(), self.P.copy(), self.mu.copy(), self.t.copy())
+        self._predict(np.flatnonzero(self.t < t), t)
+        out = self.x, self.P, self.mu
+        self.x, self.P, self.mu, self.t = saved
+        return out
 
     def _squared_distances(self, idx: np.ndarray, z: np.ndarray) -> np.ndarray:
         """Squared Mahalanobis distances (N, 2) of positions z (N, 2) from tracks ``idx``
@@ -295,7 +311,7 @@ class Tracker:
     def _initial(self, d: Detection) -> tuple[np.ndarray, np.ndarray]:
         """State and covariance of a track starting at detection ``d`` (at rest, uncertain)."""
         cfg = self.config
-        r2 = max(cfg.sigma_m, 1e-3) ** 2
+        r2 = self._r2()
         x = np.array([d.x, d.y, 0.0, 0.0, 0.0])
         P = np.diag([r2, r2, cfg.init_speed_sigma ** 2, cfg.init_speed_sigma ** 2, 0.3 ** 2])
         return x, P
@@ -352,15 +368,12 @@ class Tracker:
             return [], list(range(len(dets)))
         cfg = self.config
         z = np.array([[d.x, d.y] for d in dets])
-        saved = (self.x.copy(), self.P.copy(), self.mu.copy(), self.t.copy())
-        self._predict(cand[self.t[cand] < t], t)
-        y = z[None, :, None, :] - self.x[cand][:, None, :, :2]           # (tracks, dets, 2, 2)
-        r2 = max(cfg.sigma_m, 1e-3) ** 2
-        Sinv, det = _inv2(self.P[cand][:, :, :2, :2] + r2 * np.eye(2))   # (tracks, 2, 2, 2)
+        x, P, _ = self._predicted(t)
+        y = z[None, :, None, :] - x[cand][:, None, :, :2]                 # (tracks, dets, 2, 2)
+        Sinv, det = _inv2(self._innovation_cov(P[cand]))                  # (tracks, 2, 2, 2)
         d2 = np.einsum("ndma,nmab,ndmb->ndm", y, Sinv, y)
         cost = (d2 + np.log(det)[:, None, :]).min(axis=2)
         ok = np.hypot(y[..., 0], y[..., 1]).min(axis=2) <= cfg.gate_m
-        self.x, self.P, self.mu, self.t = saved
         young = ~self.confirmed[cand]
         if young.any():
             reach = cfg.init_max_speed * (t - self.last_seen[cand]) + 4.0 * max(cfg.sigma_m, 1e-3)
@@ -461,15 +474,10 @@ class Tracker:
             shown = shown | (d <= near[2])
         if not shown.any():
             return []
-        saved = (self.x.copy(), self.P.copy(), self.mu.copy(), self.t.copy())
-        idx = np.flatnonzero(self.t < t)
-        self._predict(idx, t)
-        mu = self.mu
-        xm = np.einsum("nm,nmk->nk", mu, self.x)
-        d = self.x - xm[:, None, :]
-        Pm = np.einsum("nm,nmkl->nkl", mu, self.P) + np.einsum("nm,nmk,nml->nkl", mu, d, d)
-        out = [TrackEstimate(n, t, xm[i], Pm[i], mu[i].copy(), float(self.radius[i]),
-                             float(self.last_seen[i]), int(self.n[i]), self.x[i].copy())
-               for i, n in enumerate(self.names) if shown[i]]
-        self.x, self.P, self.mu, self.t = saved
-        return out
+        x, P, mu = self._predicted(t)
+        xm = np.einsum("nm,nmk->nk", mu, x)
+        d = x - xm[:, None, :]
+        Pm = np.einsum("nm,nmkl->nkl", mu, P) + np.einsum("nm,nmk,nml->nkl", mu, d, d)
+        return [TrackEstimate(n, t, xm[i], Pm[i], mu[i].copy(), float(self.radius[i]),
+                              float(self.last_seen[i]), int(self.n[i]), x[i].copy())
+                for i, n in enumerate(self.names) if shown[i]]
