@@ -1,9 +1,11 @@
 """Multi-object tracking quality on recorded pedestrians, the way the field reports it.
 
 Each person of a recording (``read_obsmat``: rows t [s], x [m], y [m]) is replayed linearly
-between samples and detected at ``rate_hz`` with Gaussian noise, each visible person with
-probability ``detection_prob``, with ``clutter_rate`` false detections per frame uniform over
-the scene's bounding box; ``named`` or ``anonymous`` detections go to the robot's tracker
+between samples (a ``track`` motion) and seen by the robot's sensor in ``tracked`` mode
+(:class:`~anyplan.simulation.perception.Sensor`, the one of the closed-loop runs, here without
+a range limit): at ``rate_hz`` with Gaussian noise, each person with probability
+``detection_prob``, with ``clutter_rate`` false detections per frame uniform over the scene's
+bounding box; the ``named`` or ``anonymous`` detections go to the robot's tracker
 (:class:`~anyplan.prediction.tracking.Tracker`). Every frame its confirmed tracks are matched to
 the people present (an optimal assignment within ``match_m``), and the CLEAR MOT figures
 (Bernardin & Stiefelhagen, EURASIP JIVP 2008) are counted: misses (FN), false tracks (FP),
@@ -21,8 +23,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from anyplan.prediction.detection import Detection
 from anyplan.prediction.tracking import Tracker, TrackerConfig
+from anyplan.simulation.perception import Sensor
+from anyplan.world.motion import TrackMotion
+from anyplan.world.robot import RobotSpec, RobotState
+from anyplan.world.scenario import Scenario
+from anyplan.world.schema import MovingObstacle
+from anyplan.world.sensing import SensingSpec
 
 __all__ = ["MotScores", "evaluate_tracking"]
 
@@ -48,14 +55,23 @@ class MotScores:
         return dict(self.__dict__)
 
 
-def _positions(tracks: Mapping[int, np.ndarray], t: float) -> dict[int, np.ndarray]:
-    """The people present at ``t`` [s] (between their first and last sample), linear between
-    samples: id -> (x, y) [m]."""
-    out = {}
-    for pid, tr in tracks.items():
-        if tr[0, 0] - 1e-9 <= t <= tr[-1, 0] + 1e-9:
-            out[pid] = np.array([np.interp(t, tr[:, 0], tr[:, 1]), np.interp(t, tr[:, 0], tr[:, 2])])
-    return out
+def _scene(tracks: Mapping[int, np.ndarray], spec: SensingSpec, radius_m: float) -> Scenario:
+    """The recording as a scenario for the robot's :class:`~anyplan.simulation.perception.Sensor`:
+    each person a disc of ``radius_m`` [m] on its track (a person with one sample, an instant,
+    is left out), the arena the people's bounding box, a sensor without a range limit and no
+    occluders."""
+    people = tuple(MovingObstacle(str(pid), radius_m, TrackMotion(tr))
+                   for pid, tr in sorted(tracks.items()) if len(tr) >= 2)
+    if not people:
+        raise ValueError("no person with two samples or more")
+    allp = np.concatenate([o.motion.samples[:, 1:] for o in people])  # type: ignore[attr-defined]
+    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    centre = 0.5 * (lo + hi)
+    robot = RobotSpec(start=(float(centre[0]), float(centre[1]), 0.0),
+                      goal=(float(centre[0]), float(centre[1])))
+    return Scenario("tracking-eval", float(hi[0] - lo[0]), float(hi[1] - lo[1]), robot,
+                    moving_obstacles=people, sensing=spec,
+                    origin=(float(lo[0]), float(lo[1])))
 
 
 def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "anonymous",
@@ -64,40 +80,34 @@ def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "a
                       tracker: TrackerConfig | None = None, match_m: float = 0.5,
                       t_end: float | None = None) -> MotScores:
     """CLEAR MOT scores of the tracker on ``tracks`` (person id -> rows (t, x, y)) from 0 s to
-    ``t_end`` [s] (default: the recording's end), seeded by ``seed``."""
-    if association not in ("named", "anonymous"):
-        raise ValueError(f"unknown association '{association}'")
-    rng = np.random.default_rng(seed)
+    ``t_end`` [s] (default: the recording's end), the detections those of the robot's sensor
+    in ``tracked`` mode seeded by ``seed``.
+
+    Raises:
+        SensingError: a bad sensing setting (its ``field`` names it).
+        ValueError: no person with two samples or more.
+    """
+    spec = SensingSpec(mode="tracked", noise_m=noise_m, rate_hz=rate_hz, association=association,
+                       detection_prob=detection_prob, clutter_rate=clutter_rate)
+    scene = _scene(tracks, spec, radius_m)
+    sensor = Sensor(scene, spec, seed)
+    viewpoint = RobotState(*scene.robot.start)
     tr = Tracker(tracker or TrackerConfig(sigma_m=noise_m))
-    allp = np.concatenate([v[:, 1:] for v in tracks.values()])
-    lo, hi = allp.min(axis=0), allp.max(axis=0)
-    end = max(float(v[-1, 0]) for v in tracks.values()) if t_end is None else t_end
-    last: dict[int, str] = {}
+    end = max(o.motion.span[1] for o in scene.moving_obstacles) if t_end is None else t_end
+    last: dict[str, str] = {}
     frames = gt = tp = fp = idsw = 0
     dist = 0.0
     for k in range(int(end * rate_hz) + 1):
         t = k / rate_hz
-        truth = _positions(tracks, t)
-        dets = []
-        for pid, p in truth.items():
-            if detection_prob < 1.0 and rng.random() >= detection_prob:
-                continue
-            z = p + rng.normal(0.0, noise_m, 2)
-            dets.append(Detection(str(pid) if association == "named" else None, t,
-                                  float(z[0]), float(z[1]), radius_m))
-        for _ in range(int(rng.poisson(clutter_rate)) if clutter_rate > 0.0 else 0):
-            z = rng.uniform(lo, hi)
-            dets.append(Detection(None, t, float(z[0]), float(z[1]), radius_m))
-        if association == "anonymous":
-            dets.sort(key=lambda d: (d.x, d.y))
-        tr.update(t, dets)
+        _, dets = sensor.observe(t, viewpoint)
+        tr.update(t, list(dets))
         est = tr.estimates(t)
+        present = [o for o in scene.moving_obstacles if o.motion.exists(t)]
         frames += 1
-        gt += len(truth)
-        ids = list(truth)
-        if est and ids:
+        gt += len(present)
+        if est and present:
             e = np.array([x.state[:2] for x in est])
-            g = np.array([truth[i] for i in ids])
+            g = np.array([o.position(t) for o in present])
             d = np.hypot(e[:, None, 0] - g[None, :, 0], e[:, None, 1] - g[None, :, 1])
             rows, cols = linear_sum_assignment(np.where(d <= match_m, d, 1e6))
             pairs = [(r, c) for r, c in zip(rows, cols, strict=True) if d[r, c] <= match_m]
@@ -107,7 +117,7 @@ def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "a
         fp += len(est) - len(pairs)
         for r, c in pairs:
             dist += float(d[r, c])
-            pid = ids[c]
+            pid = present[c].name
             if pid in last and last[pid] != est[r].name:
                 idsw += 1
             last[pid] = est[r].name
