@@ -30,6 +30,7 @@ Usage::
         [--planners st-bitstar,seq-bitstar,dovs,orca] [--worlds 20-59] [--windows 9] [--seeds 1]
         [--crowd-modes tracked,twist,oracle] [--sensor-noise M] [--sensor-rate HZ]
         [--sensor-association named|anonymous] [--detection-prob P] [--clutter-rate N]
+        [--sensor-occlusion static|all]
         [--actuation-noise SV,SW] [--localization-noise SXY,STH]
         [--jobs 2] [--set [PLANNER:]KEY=VALUE ...] [--deterministic]
         [--tracker KEY=VALUE ...]
@@ -70,13 +71,14 @@ def _run(task: tuple[str, dict[str, Any], str, str, int, dict[str, Any],
     from anyplan.world.scenario import scenario_from_dict
 
     suite, data, planner, mode, seed, config, tracker, sensing, (sv, sw, sxy, sth) = task
-    noise_m, rate_hz, assoc, prob, clutter = sensing
+    noise_m, rate_hz, assoc, prob, clutter, occlusion = sensing
     sc = scenario_from_dict(data, f"<{data['name']}>")
     tracked = mode == "tracked"
     sc = override_sensing(sc, mode, noise_m if tracked else None, rate_hz if tracked else None,
                           association=assoc if tracked else None,
                           detection_prob=prob if tracked else None,
-                          clutter_rate=clutter if tracked else None)
+                          clutter_rate=clutter if tracked else None,
+                          occlusion=occlusion if tracked else None)
     try:
         res = simulate(sc, make_agent(planner, **config), seed=seed,
                        config=SimConfig(tracker=tracker, actuation_sigma_v=sv, actuation_sigma_omega=sw,
@@ -288,6 +290,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="probability of detecting a visible obstacle per frame (as anyplan run)")
     ap.add_argument("--clutter-rate", type=float, default=None, metavar="N",
                     help="false detections per frame, anonymous only (as anyplan run)")
+    ap.add_argument("--sensor-occlusion", default=None, metavar="KIND",
+                    help="static | all: what hides a moving obstacle (as anyplan run)")
     from anyplan.cli.checks import actuation_noise, localization_noise
 
     ap.add_argument("--actuation-noise", type=actuation_noise, default=(0.0, 0.0), metavar="SV,SW",
@@ -315,7 +319,7 @@ def main(argv: list[str] | None = None) -> int:
     from anyplan.world.sensing import DEFAULT_NOISE_M, DEFAULT_RATE_HZ, SensingError, SensingSpec
 
     sensing = (a.sensor_noise, a.sensor_rate, a.sensor_association, a.detection_prob,
-               a.clutter_rate)
+               a.clutter_rate, a.sensor_occlusion)
     only = set(a.only.split(","))
     modes = a.modes.split(",")
     crowd_modes = a.crowd_modes.split(",")
@@ -325,7 +329,8 @@ def main(argv: list[str] | None = None) -> int:
                         DEFAULT_RATE_HZ if a.sensor_rate is None else a.sensor_rate,
                         a.sensor_association or "named",
                         1.0 if a.detection_prob is None else a.detection_prob,
-                        0.0 if a.clutter_rate is None else a.clutter_rate)
+                        0.0 if a.clutter_rate is None else a.clutter_rate,
+                        a.sensor_occlusion or "static")
     except SensingError as exc:
         ap.error(str(exc))
     planners = []

@@ -190,3 +190,55 @@ def test_a_young_anonymous_track_near_the_robot_is_shown_at_once():
     ag0.reset(scenario_from_dict(small_scenario_dict()), np.random.default_rng(0))
     ag0.act(Observation(0.0, robot, (), (Detection(None, 0.0, *near, 0.3),)))
     assert spy0.log[-1].obstacles == ()
+
+
+def _vanishing_walker(tracker: TrackerConfig, behind_wall: bool):
+    """A person walking at 0.5 m/s who leaves the recording (``track`` motion) at 1.5 s in the
+    robot's plain view, or at 2.5 s after walking behind a wall at about 1.4 s; the robot, at
+    (1, 3), stands still. Returns (the spy's log, the tracking agent)."""
+    samples = [[0.0, 0.3, 5.0], [2.5, 1.55, 5.0]] if behind_wall else [[0.0, 2.0, 1.0], [1.5, 2.75, 1.0]]
+    d = small_scenario_dict(
+        static_obstacles=[{"name": "W", "type": "rectangle", "center": [4.0, 4.0],
+                           "size": [6.0, 0.4], "angle": 0.0}],
+        dynamic_obstacles=[{"name": "P", "type": "track", "radius": 0.25, "samples": samples}])
+    d["sensing"] = {"mode": "tracked"}
+    spy = Spy()
+    agent = TrackingAgent(spy, tracker)
+    simulate(scenario_from_dict(d), agent, seed=0, config=SimConfig(time_limit=3.0))
+    return spy.log, agent
+
+
+def test_a_person_gone_in_plain_view_is_dropped_within_visible_misses_frames():
+    log, agent = _vanishing_walker(TrackerConfig(), behind_wall=False)
+    shown = [o.t for o in log if any(ob.name == "P" for ob in o.obstacles)]
+    # the last detection is at 1.5 s; missed in view at 1.6, 1.7 and 1.8 s: gone at 1.8 s
+    assert 1.5 <= max(shown) < 1.8 + 1e-9
+    assert agent.tracker.vanished == 1
+    # without negative information it coasts drop_after_s (2 s) after its last detection
+    log, agent = _vanishing_walker(TrackerConfig(visible_misses=0), behind_wall=False)
+    shown = [o.t for o in log if any(ob.name == "P" for ob in o.obstacles)]
+    assert max(shown) >= 3.0 - 0.05 and agent.tracker.vanished == 0
+    # hidden behind the wall, it coasts (the sensor could not have seen it)
+    log, agent = _vanishing_walker(TrackerConfig(), behind_wall=True)
+    shown = [o.t for o in log if any(ob.name == "P" for ob in o.obstacles)]
+    last_seen = agent.tracker.last_seen
+    assert max(shown) >= 3.0 - 0.05 and agent.tracker.vanished == 0 and len(last_seen) == 1
+    assert 1.2 <= last_seen[0] <= 1.5
+
+
+def test_the_simulator_marks_sensor_frames():
+    d = small_scenario_dict(static_obstacles=[])
+    d["sensing"] = {"mode": "tracked", "rate_hz": 5.0}
+    spy = Spy()
+
+    class Frames(TrackingAgent):
+        def act(self, obs):
+            self.frames.append((obs.t, obs.frame, len(obs.detections)))
+            return super().act(obs)
+
+    ag = Frames(spy)
+    ag.frames = []
+    simulate(scenario_from_dict(d), ag, seed=0, config=SimConfig(time_limit=2.0))
+    at = [t for t, f, _ in ag.frames if f]
+    assert np.allclose(np.diff(at), 0.2)  # 5 Hz, whatever the control rate
+    assert all(n > 0 for t, f, n in ag.frames if f) and all(n == 0 for _, f, n in ag.frames if not f)

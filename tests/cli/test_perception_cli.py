@@ -18,6 +18,7 @@ from anyplan.cli.main import main
     (["--clutter-rate", "1"], "--clutter-rate: false detections need association: anonymous"),
     (["--sensor-association", "anonymous", "--clutter-rate", "-1"],
      "--clutter-rate: clutter rate must be >= 0"),
+    (["--sensor-occlusion", "people"], "--sensor-occlusion: unknown occlusion 'people'"),
 ])
 @pytest.mark.parametrize("command", ["run", "bench"])
 def test_bad_perception_options_exit_2_with_one_line(tmp_path, capsys, argv, words, command):

@@ -45,3 +45,17 @@ def test_clutter_and_misses_cost_what_the_counts_say_and_repeat():
     assert a.tp >= 0.8 * a.gt  # yet the two people are followed most of the time
     with pytest.raises(ValueError, match="association"):
         evaluate_tracking(tracks, association="guess")
+
+
+def test_a_person_who_leaves_in_view_is_not_counted_as_a_false_track_for_long():
+    tracks = _walks()
+    tracks[2] = tracks[2][tracks[2][:, 0] <= 1.2 + 1e-9]  # person 2 leaves the recording at 1.2 s
+    tc = {"sigma_m": 0.001, "drop_after_s": 2.0}
+    quick = evaluate_tracking(tracks, association="named", noise_m=0.0,
+                              tracker=TrackerConfig(**tc, visible_misses=3))
+    slow = evaluate_tracking(tracks, association="named", noise_m=0.0,
+                             tracker=TrackerConfig(**tc, visible_misses=0))
+    # missed at 1.3 and 1.4 s (false tracks), dropped at the third miss (1.5 s); without
+    # negative information it coasts 2 s, until 3.2 s: 20 frames
+    assert (quick.fp, slow.fp) == (2, 20)
+    assert quick.tp == slow.tp == 41 + 13 and quick.fn == slow.fn == 0

@@ -176,3 +176,76 @@ def test_a_manoeuvre_is_followed_within_a_few_frames_without_noisier_steady_stat
     assert with_m[2] < 0.5 < 1.0 < without[2]
     assert with_m[:6].mean() < 0.5 * without[:6].mean()
     assert quiet_m < 0.1 and quiet < 0.1 and abs(quiet_m - quiet) < 0.02
+
+
+def _walker_frames(tr, t0, t1, expected, present_until):
+    """Frames every 0.1 s of a walker at 1 m/s along x, detected (named) until present_until."""
+    for k in range(int(round(t0 * 10)), int(round(t1 * 10)) + 1):
+        t = k / 10
+        dets = [Detection("a", t, t, 0.0, 0.3)] if t <= present_until + 1e-9 else []
+        tr.update(t, dets, expected)
+
+
+@pytest.mark.parametrize("misses", [1, 3, 5])
+def test_a_track_missed_in_plain_view_is_dropped_after_visible_misses_frames(misses):
+    tr = Tracker(TrackerConfig(sigma_m=0.05, visible_misses=misses))
+    always = lambda c, r: np.ones(len(c), dtype=bool)  # noqa: E731
+    _walker_frames(tr, 0.0, 1.0, always, present_until=1.0)
+    assert len(tr) == 1
+    # gone at 1.0 s: missed at 1.1, 1.2, ...; dropped at the frame of its misses-th miss
+    for k in range(1, misses + 1):
+        t = 1.0 + 0.1 * k
+        tr.update(t, [], always)
+        assert len(tr) == (0 if k == misses else 1)
+    assert tr.vanished == 1 and tr.dropped == 1
+
+
+def test_a_hidden_track_coasts_and_frames_out_of_view_do_not_reset_the_count():
+    cfg = TrackerConfig(sigma_m=0.05, visible_misses=3, drop_after_s=1.5)
+    tr = Tracker(cfg)
+    never = lambda c, r: np.zeros(len(c), dtype=bool)  # noqa: E731
+    _walker_frames(tr, 0.0, 1.0, never, present_until=1.0)
+    # hidden (not expected): coasts until drop_after_s, as without negative information
+    _walker_frames(tr, 1.1, 2.5, never, present_until=1.0)
+    assert len(tr) == 1
+    tr.update(2.6, [], never)
+    assert len(tr) == 0 and tr.vanished == 0
+    # expected, hidden, expected, hidden, expected: the third expected miss drops it
+    tr = Tracker(cfg)
+    _walker_frames(tr, 0.0, 1.0, never, present_until=1.0)
+    flags = [True, False, True, False, True]
+    for k, f in enumerate(flags, 1):
+        tr.update(1.0 + 0.1 * k, [], lambda c, r, f=f: np.full(len(c), f))
+        assert len(tr) == (0 if k == 5 else 1)
+    # a detection resets the count; without ``expected`` (no sensor frame) nothing is counted
+    tr = Tracker(cfg)
+    always = lambda c, r: np.ones(len(c), dtype=bool)  # noqa: E731
+    _walker_frames(tr, 0.0, 1.0, always, present_until=1.0)
+    tr.update(1.1, [], always)
+    tr.update(1.2, [], always)
+    tr.update(1.3, [Detection("a", 1.3, 1.3, 0.0, 0.3)], always)
+    tr.update(1.4, [], always)
+    tr.update(1.5, [], always)
+    for t in (1.55, 1.6, 1.65):
+        tr.update(t, [])
+    assert len(tr) == 1
+    tr.update(1.7, [], always)
+    assert len(tr) == 0
+
+
+def test_expected_sees_the_predicted_centres_and_radii():
+    tr = Tracker(TrackerConfig(sigma_m=0.05))
+    seen = []
+
+    def expected(c, r):
+        seen.append((c.copy(), r.copy()))
+        return np.zeros(len(c), dtype=bool)
+
+    _walker_frames(tr, 0.0, 1.0, expected, present_until=1.0)
+    tr.update(1.5, [], expected)
+    c, r = seen[-1]
+    assert c.shape == (1, 2) and r.tolist() == [0.3]
+    assert c[0] == pytest.approx([1.5, 0.0], abs=0.1)  # predicted at 1 m/s to 1.5 s
+    assert TrackerConfig().visible_misses == 3
+    with pytest.raises(ValueError, match="visible_misses"):
+        TrackerConfig(visible_misses=-1)

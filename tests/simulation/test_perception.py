@@ -358,6 +358,8 @@ def test_named_detections_are_unchanged_by_the_new_settings():
     ({"detection_prob": 1.5}, "sensing.detection_prob", "<= 1"),
     ({"association": "anonymous", "clutter_rate": -1.0}, "sensing.clutter_rate", ">= 0"),
     ({"clutter_rate": 2.0}, "sensing.clutter_rate", "association: anonymous"),
+    ({"occlusion": "people"}, "sensing.occlusion", "unknown occlusion 'people'"),
+    ({"occlusion": 1}, "sensing.occlusion", "string"),
 ])
 def test_bad_association_settings_name_the_field(block, field, words):
     d = small_scenario_dict()
@@ -394,3 +396,25 @@ def test_a_run_with_anonymous_detections_and_clutter_tracks_and_repeats():
     truth = [o.position(ag.log[-1].t) for o in sc.moving_obstacles]
     assert len(last) == 4
     assert all(min(math.hypot(o.x - q[0], o.y - q[1]) for o in last) < 0.3 for q in truth)
+
+
+def test_with_occlusion_all_a_disc_hides_what_is_behind_it():
+    # D0..D3 walk up x = 1.5, 3, 4.5, 6 from y = 0.5; a robot at (0, 0.5) looks along their row
+    d = small_scenario_dict(static_obstacles=[])
+    d["dynamic_obstacles"] = [
+        {"name": f"D{k}", "start": [1.5 + 1.5 * k, 0.5, 1.5708], "v": 0.2, "omega": 0.0,
+         "radius": 0.3} for k in range(4)]
+    d["sensing"] = {"mode": "tracked", "occlusion": "all", "noise_m": 0.0}
+    sc = scenario_from_dict(d)
+    assert scenario_from_dict(sc.to_dict()).sensing == sc.sensing
+    s = Sensor(sc, sc.sensing, seed=0)
+    _, det = s.observe(0.0, RobotState(0.0, 0.5, 0.0))
+    assert [x.name for x in det] == ["D0"]  # the first one hides the three behind it
+    assert s.record()["occlusion"] == "all"
+    # from beside the row every one is seen, as with static occlusion only
+    _, det = s.observe(0.1, RobotState(3.75, 3.0, 0.0))
+    assert sorted(x.name for x in det) == ["D0", "D1", "D2", "D3"]
+    plain = override_sensing(sc, occlusion="static")
+    static = Sensor(plain, plain.sensing, 0)
+    _, det = static.observe(0.0, RobotState(0.0, 0.5, 0.0))
+    assert len(det) == 4 and "occlusion" not in static.record()

@@ -43,6 +43,10 @@ class Observation:
         odom: The robot's odometry pose: its start moved by the twist its drive reports, step
             by step (smooth, drifting with an execution error); the pose of ``robot`` is the
             localizer's. None when not given.
+        frame: True at a step where the sensor took a frame (``tracked``), its detections
+            possibly none: what it did not detect there, it did not see (a tracker's negative
+            information). False elsewhere, and when not known (a step with detections is a
+            frame all the same).
     """
 
     t: float
@@ -50,6 +54,7 @@ class Observation:
     obstacles: tuple[ObstacleObservation, ...] = ()
     detections: tuple[Detection, ...] = ()
     odom: RobotState | None = None
+    frame: bool = False
 
 
 @dataclass

@@ -1,19 +1,17 @@
 """The robot's tracking front end: noisy detections in, estimated obstacles out, for any agent.
 
-With ``tracked`` perception the simulator hands agents only
-:class:`~anyplan.prediction.detection.Detection` records. :class:`TrackingAgent` wraps any agent:
-at every step it feeds the detections to an IMM tracker
+With ``tracked`` perception agents get only :class:`~anyplan.prediction.detection.Detection`
+records. :class:`TrackingAgent` wraps any agent: it feeds them to an IMM tracker
 (:class:`~anyplan.prediction.tracking.Tracker`) and gives the inner agent an
 :class:`~anyplan.agents.base.Observation` whose obstacles are the tracks' estimates (pose and
 twist of the mean, no motion model) carrying the growth of their uncertain disc
-(:class:`~anyplan.prediction.uncertain.UncertaintyModel`). Tracks are kept in the robot's
-odometry frame (``Observation.odom``) whenever the localizer's pose differs from it. Anonymous
-detections are associated by the tracker (a detection then bears its track's name; a young
-track near the robot is shown at once, ``TrackerConfig.urgent_gap_m``). A detection
-that leaves the tube of the prediction the agent last planned against (its extra radius capped at
-``UncertaintyModel.tube_cap_m``, plus 3 noise standard deviations) asks the agent to replan
-(``request_replan(reason)``). Both in ``docs/perception.md``, "The pipeline in ``tracked``
-mode".
+(:class:`~anyplan.prediction.uncertain.UncertaintyModel`), in the odometry frame whenever the
+localizer's pose differs from it. The tracker associates anonymous detections (a young track
+near the robot is shown at once, ``TrackerConfig.urgent_gap_m``) and drops a track missed
+where the robot's sensor should have seen it (``TrackerConfig.visible_misses``). A detection
+outside the tube of the prediction the agent last planned against (its extra radius capped at
+``UncertaintyModel.tube_cap_m``, plus 3 noise sigmas) asks the agent to replan
+(``request_replan(reason)``). Both in ``docs/perception.md``, "The pipeline in ``tracked`` mode".
 """
 
 from __future__ import annotations
@@ -25,13 +23,15 @@ import numpy as np
 
 from anyplan.agents.base import Agent, AgentStats, Observation
 from anyplan.agents.stats import TrackerCounts
+from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.se2 import carry
 from anyplan.prediction.base import ConstantTwistPredictor, ObstacleObservation, PredictedObstacle
 from anyplan.prediction.detection import Detection
-from anyplan.prediction.tracking import Tracker, TrackerConfig
+from anyplan.prediction.tracking import Expected, Tracker, TrackerConfig
 from anyplan.prediction.uncertain import UNCERTAINTY_SETTINGS, UncertaintyModel
 from anyplan.world.robot import Command
 from anyplan.world.scenario import Scenario
+from anyplan.world.view import FieldOfView, field_of_view
 
 __all__ = ["TrackingAgent"]
 
@@ -48,6 +48,7 @@ class TrackingAgent(Agent):
     def __init__(self, inner: Agent, tracker: TrackerConfig | None = None,
                  uncertainty: UncertaintyModel | None = None) -> None:
         self._radius = 0.0  # the robot's [m]
+        self._view = FieldOfView(None, ObstacleSet([]))  # the robot's sensor's (set by reset)
         self.inner = inner
         self.tracker_config = tracker or TrackerConfig()
         self.uncertainty = uncertainty or UncertaintyModel()
@@ -71,6 +72,7 @@ class TrackingAgent(Agent):
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
         self.inner.reset(scenario, rng)
         self._radius = scenario.robot.radius
+        self._view = field_of_view(scenario)
         self.tracker = Tracker(self.tracker_config)
         self._tube = {}
         self._plans = 0
@@ -97,6 +99,19 @@ class TrackingAgent(Agent):
                 return d.name
         return None
 
+    def _expected(self, believed: tuple[float, float, float],
+                  odom: tuple[float, float, float] | None) -> Expected:
+        """What the sensor should have seen of the tracks (in the tracker's frame, the odometry
+        pose's when it differs from the believed one): their centres in view from the robot,
+        past the static obstacles and the other tracks' discs (:meth:`FieldOfView.expected`)."""
+        view = self._view
+
+        def expected(centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
+            c = centres if odom is None else _moved(centres, odom, believed)
+            return view.expected(believed[:2], c, radii)
+
+        return expected
+
     def act(self, obs: Observation) -> Command:
         r, o = obs.robot, obs.odom
         believed = (r.x, r.y, r.theta)
@@ -105,7 +120,10 @@ class TrackingAgent(Agent):
         if odom is not None and dets:
             q = _moved(np.array([[d.x, d.y] for d in dets]), believed, odom)
             dets = tuple(replace(d, x=float(x), y=float(y)) for d, (x, y) in zip(dets, q, strict=True))
-        labelled = self.tracker.update(obs.t, dets)
+        expected = None
+        if (obs.frame or dets) and self.tracker_config.visible_misses > 0.0:
+            expected = self._expected(believed, odom)
+        labelled = self.tracker.update(obs.t, dets, expected)
         near = None
         gap = self.tracker_config.urgent_gap_m
         if gap > 0.0 and self.tracker.started:

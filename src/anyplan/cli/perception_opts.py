@@ -7,19 +7,19 @@ from collections.abc import Sequence
 
 from anyplan.errors import UsageError
 from anyplan.world.scenario import Scenario
-from anyplan.world.sensing import ASSOCIATIONS, DEFAULT_NOISE_M, DEFAULT_RATE_HZ, MODES
+from anyplan.world.sensing import ASSOCIATIONS, DEFAULT_NOISE_M, DEFAULT_RATE_HZ, MODES, OCCLUSIONS
 
 __all__ = ["add_perception_options", "apply_perception", "add_tracker_option", "tracker_settings"]
 
 #: :class:`~anyplan.world.sensing.SensingSpec` fields -> the flags that set them.
 _FLAGS = {"mode": "--perception", "noise_m": "--sensor-noise", "rate_hz": "--sensor-rate",
           "association": "--sensor-association", "detection_prob": "--detection-prob",
-          "clutter_rate": "--clutter-rate"}
+          "clutter_rate": "--clutter-rate", "occlusion": "--sensor-occlusion"}
 
 
 def add_perception_options(p: argparse.ArgumentParser) -> None:
     """Add ``--perception``, ``--sensor-noise``, ``--sensor-rate``, ``--sensor-association``,
-    ``--detection-prob`` and ``--clutter-rate`` to ``p``."""
+    ``--detection-prob``, ``--clutter-rate`` and ``--sensor-occlusion`` to ``p``."""
     p.add_argument("--perception", default=None, metavar="MODE",
                    help=f"what the robot knows of the moving obstacles: {' | '.join(MODES)} "
                         "(default: the scenario's sensing block, else oracle; overrides it)")
@@ -39,6 +39,10 @@ def add_perception_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--clutter-rate", type=float, default=None, metavar="N",
                    help="tracked, anonymous: mean number of false detections per frame "
                         "(default: the scenario's, else 0)")
+    p.add_argument("--sensor-occlusion", default=None, metavar="KIND",
+                   help=f"tracked: {' | '.join(OCCLUSIONS)}: what hides a moving obstacle, the "
+                        "static obstacles or also the other moving obstacles (default: the "
+                        "scenario's, else static)")
 
 
 def apply_perception(command: str, scenarios: Sequence[Scenario],
@@ -55,7 +59,8 @@ def apply_perception(command: str, scenarios: Sequence[Scenario],
         return [override_sensing(sc, args.perception, args.sensor_noise, args.sensor_rate,
                                  association=args.sensor_association,
                                  detection_prob=args.detection_prob,
-                                 clutter_rate=args.clutter_rate)
+                                 clutter_rate=args.clutter_rate,
+                                 occlusion=args.sensor_occlusion)
                 for sc in scenarios]
     except ValueError as exc:  # a SensingError names its field; the flag is told here
         opt = _FLAGS.get(getattr(exc, "field", ""), "--perception")

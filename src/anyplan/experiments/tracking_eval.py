@@ -93,6 +93,11 @@ def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "a
     sensor = Sensor(scene, spec, seed)
     viewpoint = RobotState(*scene.robot.start)
     tr = Tracker(tracker or TrackerConfig(sigma_m=noise_m))
+
+    def expected(centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
+        """The tracks the sensor should have seen: as the robot's tracking front end."""
+        return sensor.view.expected((viewpoint.x, viewpoint.y), centres, radii)
+
     end = max(o.motion.span[1] for o in scene.moving_obstacles) if t_end is None else t_end
     last: dict[str, str] = {}
     frames = gt = tp = fp = idsw = 0
@@ -100,7 +105,7 @@ def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "a
     for k in range(int(end * rate_hz) + 1):
         t = k / rate_hz
         _, dets = sensor.observe(t, viewpoint)
-        tr.update(t, list(dets))
+        tr.update(t, list(dets), expected)
         est = tr.estimates(t)
         present = [o for o in scene.moving_obstacles if o.motion.exists(t)]
         frames += 1

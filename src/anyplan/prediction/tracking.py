@@ -7,8 +7,8 @@ measurements are positions with noise ``sigma_m`` [m] per axis. Named detections
 obstacle's track; anonymous ones (no name, some false) are associated by global nearest
 neighbour within the gate (optimal assignments on the innovations' likelihood, established
 tracks first), and a track they start is reported only once confirmed (``confirm_hits``
-updates) and kept unseen as long as its detections have earned. Tracks start at
-their first detection, coast while occluded and are dropped after ``drop_after_s``.
+updates) and kept unseen as long as its detections have earned. Tracks coast while hidden,
+up to ``drop_after_s``, and go after ``visible_misses`` frames missed in plain view.
 Everything is vectorised over tracks.
 
 The models and their noise terms: ``docs/perception.md``, "The IMM tracker" and "Anonymous
@@ -18,7 +18,7 @@ detections".
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -27,7 +27,11 @@ from scipy.optimize import linear_sum_assignment
 from anyplan.config import setting, validate
 from anyplan.prediction.detection import Detection
 
-__all__ = ["TrackerConfig", "Tracker", "TrackEstimate", "ct_transition"]
+__all__ = ["TrackerConfig", "Tracker", "TrackEstimate", "ct_transition", "Expected"]
+
+#: What the sensor should have detected in a frame: predicted centres (N, 2) [m], radii (N,)
+#: [m] -> mask (N,).
+Expected = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 _H = np.zeros((2, 5))
 _H[0, 0] = _H[1, 1] = 1.0
@@ -72,6 +76,12 @@ class TrackerConfig:
             only within this speed [m/s] (plus 4 noise sigmas) of its last one: its velocity is
             still a guess and its gate would be metres wide (two-point initiation with a
             velocity gate, Blackman & Popoli 1999, section 6.3).
+        visible_misses: A track the sensor should have detected (its predicted centre in view,
+            no other track in the way: ``update``'s ``expected``) and did not, this many frames
+            in a row, is dropped (0: never): a track's absence where the sensor looks is
+            evidence that the obstacle is gone (negative information; an obstacle that left or
+            jumped), where a hidden one coasts up to ``drop_after_s``. Frames where the track
+            is not expected neither count nor reset the count.
     """
 
     sigma_m: float = setting(0.05, lo=0.0, unit="m", doc="measurement noise per axis")
@@ -100,6 +110,8 @@ class TrackerConfig:
                                   doc="anonymous: young tracks this near the robot are shown")
     init_max_speed: float = setting(3.0, lo=0.0, lo_open=True, unit="m/s",
                                     doc="anonymous: fastest an unconfirmed track may move")
+    visible_misses: float = setting(3.0, lo=0.0, hi=1000.0, unit="",
+                                    doc="frames missed in view that drop a track (0: never)")
 
     def __post_init__(self) -> None:
         validate(self)
@@ -218,10 +230,12 @@ class Tracker:
         self.confirmed = np.zeros(0, dtype=bool)  # reported by estimates()
         self.last_z = np.zeros((0, 2))  # the last detection's position [m]
         self.born_named = np.zeros(0, dtype=bool)  # started by a named detection
+        self.missed = np.zeros(0, dtype=int)  # frames in a row expected in view and missed
         self.started = 0  # tracks started from anonymous detections (their names: track-K)
         self.dropped = 0  # confirmed tracks dropped
         self.discarded = 0  # tracks dropped before confirmation (anonymous: mostly clutter)
         self.restarted = 0  # tracks restarted at a detection outside their gate (jumps)
+        self.vanished = 0  # tracks dropped after visible_misses frames missed in view
         self.manoeuvres = 0  # updates that got the manoeuvre noise
 
     def __len__(self) -> int:
@@ -331,6 +345,7 @@ class Tracker:
         self.names.append(d.name)
         self.confirmed = np.append(self.confirmed, confirmed)
         self.born_named = np.append(self.born_named, confirmed)
+        self.missed = np.append(self.missed, 0)
         self.last_z = np.concatenate([self.last_z, [[d.x, d.y]]])
         self.x = np.concatenate([self.x, np.broadcast_to(x, (1, 2, 5))])
         self.P = np.concatenate([self.P, np.broadcast_to(P, (1, 2, 5, 5))])
@@ -348,7 +363,7 @@ class Tracker:
         self.t, self.last_seen = self.t[keep], self.last_seen[keep]
         self.radius, self.n = self.radius[keep], self.n[keep]
         self.confirmed, self.last_z = self.confirmed[keep], self.last_z[keep]
-        self.born_named = self.born_named[keep]
+        self.born_named, self.missed = self.born_named[keep], self.missed[keep]
 
     def _associate(self, t: float, dets: list[Detection], taken: set[int]
                    ) -> tuple[list[tuple[int, int]], list[int]]:
@@ -402,11 +417,16 @@ class Tracker:
         return pairs, [j for j in range(len(dets)) if free[j]]
 
     # --- public ----------------------------------------------------------------------------------
-    def update(self, t: float, detections: Iterable[Detection]) -> tuple[Detection, ...]:
+    def update(self, t: float, detections: Iterable[Detection],
+               expected: Expected | None = None) -> tuple[Detection, ...]:
         """One sensor frame at time ``t`` [s]: associate the anonymous detections
         (:meth:`_associate`), update the detected tracks, start new ones, coast the others and
         drop those unseen for ``drop_after_s`` (anonymous ones: the patience they earned,
-        ``tentative_drop_s``).
+        ``tentative_drop_s``), or missed ``visible_misses`` frames in a row where the sensor
+        should have seen them: ``expected`` (predicted centres (N, 2), radii (N,) [m]) -> mask
+        (N,) of the tracks it should have detected in this frame (e.g.
+        :meth:`anyplan.world.view.FieldOfView.expected`); None (the default, also for a step
+        that is no sensor frame): nothing is known of the tracks not detected.
         Returns the detections, an anonymous one named after the track it updated or started."""
         dets = list(detections)
         index = {n: i for i, n in enumerate(self.names)}
@@ -446,6 +466,13 @@ class Tracker:
             self.last_z[idx] = z
             self.n[idx] += 1
             self.radius[idx] = [d.radius for _, d in upd]
+        if expected is not None and len(self.names):
+            hit = np.zeros(len(self.names), dtype=bool)
+            hit[[i for i, _ in upd]] = True
+            x, _, mu = self._predicted(t)
+            centres = np.einsum("nm,nmk->nk", mu, x[:, :, :2])
+            seen_by_sensor = np.asarray(expected(centres, self.radius), dtype=bool)
+            self.missed = np.where(hit, 0, self.missed + (seen_by_sensor & ~hit))
         for d, named in new:
             self._add(d, named)
         self.confirmed |= self.n >= round(self.config.confirm_hits)
@@ -456,6 +483,10 @@ class Tracker:
                          cfg.tentative_drop_s, cfg.drop_after_s)
         patience = np.where(self.born_named, cfg.drop_after_s, earned)
         keep = t - self.last_seen <= patience + 1e-9
+        if cfg.visible_misses > 0.0:
+            gone = self.missed >= round(cfg.visible_misses)
+            self.vanished += int((gone & keep).sum())
+            keep &= ~gone
         if not keep.all():
             self._drop(keep)
         return tuple(d if d.name is not None else replace(d, name=lab)

@@ -4,7 +4,8 @@ Modes (:class:`~anyplan.world.sensing.SensingSpec`): ``oracle`` (exact pose, twi
 model within ``robot.sensing_range``, the paper's assumption), ``twist`` (the same without the
 motion model) and ``tracked`` (noisy position detections of the visible obstacles at the sensor
 rate). An obstacle is visible when its centre is in range and in line of sight past the static
-obstacles; it exists only within its motion's span. Noise comes from a Generator seeded with
+obstacles (``occlusion: all``: and past the other moving discs, :mod:`anyplan.world.view`); it
+exists only within its motion's span. Noise comes from a Generator seeded with
 ``(seed, NOISE_STREAM)``: the same seed, the same noise. Anonymous detections (no names, in
 the order of their x), missed detections and false ones (clutter) draw from a second Generator,
 ``(seed, CLUTTER_STREAM)``.
@@ -25,7 +26,6 @@ import numpy as np
 from anyplan.agents.base import Agent
 from anyplan.agents.perceiving import TrackingAgent
 from anyplan.errors import UnknownNameError
-from anyplan.geometry.collision import ObstacleSet
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.prediction.detection import Detection
 from anyplan.prediction.tracking import TrackerConfig
@@ -33,6 +33,7 @@ from anyplan.prediction.uncertain import UNCERTAINTY_SETTINGS, UncertaintyModel
 from anyplan.world.robot import RobotState
 from anyplan.world.scenario import Scenario
 from anyplan.world.sensing import SensingSpec
+from anyplan.world.view import field_of_view
 
 __all__ = ["NOISE_STREAM", "CLUTTER_STREAM", "Sensor", "observe_exact", "effective_sensing",
            "override_sensing", "with_tracking", "tracking_setting_names", "tracking_configs",
@@ -89,7 +90,8 @@ class Sensor:
         self.rng = np.random.default_rng(list(self.seed_sequence))
         self.clutter_seed = (int(seed), CLUTTER_STREAM)
         self.clutter_rng = np.random.default_rng(list(self.clutter_seed))
-        self.occluders = ObstacleSet([o.shape for o in scenario.static_obstacles])
+        #: What the sensor sees from the robot: its range and the static obstacles' shadows.
+        self.view = field_of_view(scenario)
         radii = [o.radius for o in scenario.moving_obstacles]
         #: Radius [m] a false detection reports: the median of the moving obstacles'.
         self.clutter_radius = float(np.median(radii)) if radii else 0.25
@@ -111,15 +113,13 @@ class Sensor:
             out.update(association=sp.association, detection_prob=sp.detection_prob,
                        clutter_rate=sp.clutter_rate, clutter_seed=list(self.clutter_seed),
                        missed=self.missed, false_detections=self.false_detections)
+        if sp.occlusion != "static":
+            out.update(occlusion=sp.occlusion)
         return out
 
     def visible(self, robot: RobotState, centres: np.ndarray) -> np.ndarray:
         """Mask (N,): centres (N, 2) [m] in line of sight of the robot's centre (exact)."""
-        n = len(centres)
-        if n == 0 or len(self.occluders) == 0:
-            return np.ones(n, dtype=bool)
-        a = np.tile([robot.x, robot.y], (n, 1))
-        return self.occluders.segments_clearance(a, centres) > 0.0
+        return self.view.line_of_sight((robot.x, robot.y), centres)
 
     def observe(self, t: float, robot: RobotState
                 ) -> tuple[tuple[ObstacleObservation, ...], tuple[Detection, ...]]:
@@ -137,12 +137,11 @@ class Sensor:
         if not movers and spec.clutter_rate == 0.0:
             return (), ()
         p = np.array([o.position(t) for o in movers]).reshape(-1, 2)
-        keep = np.ones(len(movers), dtype=bool)
-        rng_limit = self.scenario.robot.sensing_range
-        if rng_limit is not None:
-            keep &= np.hypot(p[:, 0] - robot.x, p[:, 1] - robot.y) <= rng_limit
-        idx = np.flatnonzero(keep)
-        idx = idx[self.visible(robot, p[idx])]
+        if spec.occlusion == "all":  # the other discs hide what is behind them
+            radii = np.array([o.radius for o in movers])
+            idx = np.flatnonzero(self.view.expected((robot.x, robot.y), p, radii))
+        else:
+            idx = np.flatnonzero(self.view.visible((robot.x, robot.y), p))
         if spec.detection_prob < 1.0 and len(idx):
             hit = self.clutter_rng.random(len(idx)) < spec.detection_prob
             self.missed += int((~hit).sum())
@@ -188,8 +187,8 @@ class Sensor:
 
 def override_sensing(scenario: Scenario, mode: str | None = None, noise_m: float | None = None,
                      rate_hz: float | None = None, *, association: str | None = None,
-                     detection_prob: float | None = None,
-                     clutter_rate: float | None = None) -> Scenario:
+                     detection_prob: float | None = None, clutter_rate: float | None = None,
+                     occlusion: str | None = None) -> Scenario:
     """The scenario with its sensing settings overridden where given (None keeps the
     scenario's, or the defaults when it has no ``sensing:`` block).
 
@@ -199,7 +198,7 @@ def override_sensing(scenario: Scenario, mode: str | None = None, noise_m: float
     """
     given: dict[str, Any] = {
         "mode": mode, "noise_m": noise_m, "rate_hz": rate_hz, "association": association,
-        "detection_prob": detection_prob, "clutter_rate": clutter_rate}
+        "detection_prob": detection_prob, "clutter_rate": clutter_rate, "occlusion": occlusion}
     given = {k: (v if isinstance(v, str) else float(v)) for k, v in given.items() if v is not None}
     if not given:
         return scenario

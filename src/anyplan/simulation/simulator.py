@@ -241,12 +241,14 @@ class Simulation:
     def observation(self) -> Observation:
         """What an agent sees now (call it once per step: a sensor may keep state): with a
         localization error, its pose as it believes it, and what it senses placed from there."""
+        frames = self.sensor.frames
         seen, detections = self.sensor.observe(self.t, self.state)
+        frame = self.sensor.frames != frames
         loc = self.localization
         if loc is None:
-            return Observation(self.t, self.state, seen, detections, self.odom)
+            return Observation(self.t, self.state, seen, detections, self.odom, frame)
         return Observation(self.t, loc.estimate(self.state), loc.observed(self.state, seen),
-                           loc.detected(self.state, detections), self.odom)
+                           loc.detected(self.state, detections), self.odom, frame)
 
     def step(self, cmd: Command) -> None:
         """Clip ``cmd`` to the robot's limits, integrate one step, move the obstacles, test the

@@ -287,7 +287,7 @@ def parse_sensing(c: Ctx, obj: Any) -> SensingSpec:
     """The ``sensing:`` block."""
     m = c.mapping(obj, "sensing")
     c.keys(m, "sensing", ("mode",), ("noise_m", "rate_hz", "association", "detection_prob",
-                                     "clutter_rate"))
+                                     "clutter_rate", "occlusion"))
     mode = c.string(m["mode"], "sensing.mode")
     noise = c.number(m.get("noise_m", SensingSpec.noise_m), "sensing.noise_m", nonneg=True,
                      hi=L.MAX_SIZE_M)
@@ -298,7 +298,8 @@ def parse_sensing(c: Ctx, obj: Any) -> SensingSpec:
                     positive=True, hi=1.0)
     clutter = c.number(m.get("clutter_rate", SensingSpec.clutter_rate), "sensing.clutter_rate",
                        nonneg=True, hi=MAX_CLUTTER_RATE)
+    occlusion = c.string(m.get("occlusion", SensingSpec.occlusion), "sensing.occlusion")
     try:
-        return SensingSpec(mode, noise, rate, assoc, prob, clutter)
+        return SensingSpec(mode, noise, rate, assoc, prob, clutter, occlusion)
     except SensingError as exc:
         raise c.fail(f"sensing.{exc.field}", str(exc)) from None

@@ -9,7 +9,8 @@ Three modes (``docs/scenarios.md``, "Sensing"):
   ``rate_hz`` [Hz], within ``robot.sensing_range`` and in line of sight; each detection keeps
   its radius and, with ``association: named`` (the default), the obstacle's name (perfect
   association); ``anonymous`` detections carry no identity, a visible obstacle is detected with
-  probability ``detection_prob`` and ``clutter_rate`` false detections come per frame.
+  probability ``detection_prob`` and ``clutter_rate`` false detections come per frame; with
+  ``occlusion: all`` the moving obstacles hide one another too.
 
 The sensor itself lives in :mod:`anyplan.simulation.perception`; this module only holds the
 validated settings, so that the scenario loader can parse them.
@@ -22,13 +23,16 @@ from dataclasses import dataclass
 
 from anyplan.errors import AnyplanError
 
-__all__ = ["MODES", "ASSOCIATIONS", "SensingSpec", "SensingError", "DEFAULT_NOISE_M",
+__all__ = ["MODES", "ASSOCIATIONS", "OCCLUSIONS", "SensingSpec", "SensingError", "DEFAULT_NOISE_M",
            "DEFAULT_RATE_HZ", "MAX_CLUTTER_RATE"]
 
 #: Known perception modes.
 MODES = ("oracle", "twist", "tracked")
 #: How ``tracked`` detections are told apart: by the obstacle's name, or not at all.
 ASSOCIATIONS = ("named", "anonymous")
+#: What hides a moving obstacle from the ``tracked`` sensor: the static obstacles, or also the
+#: other moving obstacles' discs.
+OCCLUSIONS = ("static", "all")
 #: Largest mean number of false detections per frame.
 MAX_CLUTTER_RATE = 1000.0
 #: Default position noise [m] (standard deviation per axis) of ``tracked``.
@@ -39,7 +43,7 @@ DEFAULT_RATE_HZ = 10.0
 
 class SensingError(AnyplanError, ValueError):
     """A bad perception setting; ``field`` names it (``mode``, ``noise_m``, ``rate_hz``,
-    ``association``, ``detection_prob`` or ``clutter_rate``)."""
+    ``association``, ``detection_prob``, ``clutter_rate`` or ``occlusion``)."""
 
     def __init__(self, field: str, message: str) -> None:
         self.field = field
@@ -61,11 +65,14 @@ class SensingSpec:
             (``tracked``).
         clutter_rate: Mean number of false detections per frame (Poisson), >= 0; only with
             ``anonymous`` association (a named detection is a real obstacle) (``tracked``).
+        occlusion: ``static`` (the static obstacles hide what is behind them) or ``all`` (the
+            moving obstacles' discs too: a person behind a person is not detected)
+            (``tracked``).
 
     Raises:
-        SensingError: an unknown mode or association, a negative or non-finite noise, a rate
-            that is not > 0, a detection probability outside (0, 1], a negative clutter rate
-            or clutter with named detections.
+        SensingError: an unknown mode, association or occlusion, a negative or non-finite
+            noise, a rate that is not > 0, a detection probability outside (0, 1], a negative
+            clutter rate or clutter with named detections.
     """
 
     mode: str = "oracle"
@@ -74,6 +81,7 @@ class SensingSpec:
     association: str = "named"
     detection_prob: float = 1.0
     clutter_rate: float = 0.0
+    occlusion: str = "static"
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -95,6 +103,9 @@ class SensingSpec:
         if not (math.isfinite(self.clutter_rate) and 0.0 <= self.clutter_rate <= MAX_CLUTTER_RATE):
             raise SensingError("clutter_rate", "clutter rate must be >= 0 and <= "
                                                f"{MAX_CLUTTER_RATE:g} per frame, got {self.clutter_rate:g}")
+        if self.occlusion not in OCCLUSIONS:
+            raise SensingError("occlusion", f"unknown occlusion '{self.occlusion}' "
+                                            f"(known: {', '.join(OCCLUSIONS)})")
         if self.clutter_rate > 0.0 and self.association != "anonymous":
             raise SensingError("clutter_rate", "false detections need association: anonymous "
                                                "(a named detection is a real obstacle)")
@@ -110,4 +121,6 @@ class SensingSpec:
             out["detection_prob"] = self.detection_prob
         if self.clutter_rate != 0.0:
             out["clutter_rate"] = self.clutter_rate
+        if self.occlusion != "static":
+            out["occlusion"] = self.occlusion
         return out
