@@ -55,3 +55,24 @@ def test_range_and_walls():
     assert FieldOfView(None, EMPTY).expected((0.0, 0.0), two, np.array([0.3, 0.3])).tolist() \
         == [True, False]
     assert FieldOfView(None, EMPTY).expected((0.0, 0.0), np.zeros((0, 2)), np.zeros(0)).shape == (0,)
+
+
+def test_an_occupancy_maps_walls_occlude(tmp_path):
+    from anyplan.world.scenario import load_scenario
+    from anyplan.world.view import field_of_view
+    from tests.world.test_occupancy import write_pgm, write_yaml
+
+    px = np.full((10, 10), 255)
+    px[2:8, 5] = 0  # a wall x in [2.5, 3] m, y in [1, 4] m (the image's top row is y = 4.5-5)
+    write_pgm(tmp_path / "m.pgm", px)
+    write_yaml(tmp_path / "m.yaml", "m.pgm", resolution=0.5)
+    f = tmp_path / "s.yaml"
+    f.write_text("name: s\nstatic_map: m.yaml\nrobot: {start: [1, 2.5, 0], goal: [4, 0.5], "
+                 "radius: 0.2, v_max: 1, omega_max: 1, a_max: 1, alpha_max: 1}\n"
+                 "sensing: {mode: tracked}\n")
+    view = field_of_view(load_scenario(f))
+    c = np.array([[4.0, 2.5], [2.0, 2.5], [3.2, 4.9], [4.0, 0.25]])
+    # behind the wall, in front of it, past its top end (the line crosses x = 2.5 at y = 4.14),
+    # behind its lower part
+    assert view.visible((1.0, 2.5), c).tolist() == [False, True, True, False]
+    assert FieldOfView(None, EMPTY).visible((1.0, 2.5), c).all()

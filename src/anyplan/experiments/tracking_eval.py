@@ -76,19 +76,21 @@ def _scene(tracks: Mapping[int, np.ndarray], spec: SensingSpec, radius_m: float)
 
 def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "anonymous",
                       noise_m: float = 0.05, rate_hz: float = 10.0, detection_prob: float = 1.0,
-                      clutter_rate: float = 0.0, seed: int = 0, radius_m: float = 0.25,
-                      tracker: TrackerConfig | None = None, match_m: float = 0.5,
-                      t_end: float | None = None) -> MotScores:
+                      clutter_rate: float = 0.0, occlusion: str = "static", seed: int = 0,
+                      radius_m: float = 0.25, tracker: TrackerConfig | None = None,
+                      match_m: float = 0.5, t_end: float | None = None) -> MotScores:
     """CLEAR MOT scores of the tracker on ``tracks`` (person id -> rows (t, x, y)) from 0 s to
     ``t_end`` [s] (default: the recording's end), the detections those of the robot's sensor
-    in ``tracked`` mode seeded by ``seed``.
+    in ``tracked`` mode seeded by ``seed``, seeing from the scene's centre (``occlusion:
+    all``: the people nearer to it hide those behind them; a person hidden counts as missed).
 
     Raises:
         SensingError: a bad sensing setting (its ``field`` names it).
         ValueError: no person with two samples or more.
     """
     spec = SensingSpec(mode="tracked", noise_m=noise_m, rate_hz=rate_hz, association=association,
-                       detection_prob=detection_prob, clutter_rate=clutter_rate)
+                       detection_prob=detection_prob, clutter_rate=clutter_rate,
+                       occlusion=occlusion)
     scene = _scene(tracks, spec, radius_m)
     sensor = Sensor(scene, spec, seed)
     viewpoint = RobotState(*scene.robot.start)

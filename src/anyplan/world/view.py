@@ -24,10 +24,13 @@ __all__ = ["FieldOfView", "field_of_view"]
 
 
 def field_of_view(scenario: Scenario) -> FieldOfView:
-    """The view of the scenario's robot: ``robot.sensing_range`` and the static obstacles as
-    occluders (an occupancy map's cells do not occlude)."""
-    return FieldOfView(scenario.robot.sensing_range,
-                       ObstacleSet([o.shape for o in scenario.static_obstacles]))
+    """The view of the scenario's robot: ``robot.sensing_range``, and the static obstacles and
+    an occupancy map's blocked cells (merged boxes, indexed) as occluders; the arena's walls do
+    not occlude (everything is inside them)."""
+    shapes = [o.shape for o in scenario.static_obstacles]
+    occluders = ObstacleSet(shapes) if scenario.static_map is None \
+        else scenario.static_map.obstacle_set(shapes)
+    return FieldOfView(scenario.robot.sensing_range, occluders)
 
 
 @dataclass(frozen=True)
