@@ -162,23 +162,22 @@ def _tracking(tracker: tuple[tuple[str, float], ...] = ()) -> str:
     (``occlusion: all``) (``anyplan.experiments.tracking_eval``)."""
     from anyplan.experiments.crowds import read_obsmat
     from anyplan.experiments.tracking_eval import evaluate_tracking
-    from anyplan.simulation.perception import tracking_configs
-
-    tc, _ = tracking_configs(dict(tracker), 0.05)
     rows = [("named", 1.0, 0.0, "static"), ("anonymous", 1.0, 0.0, "static"),
             ("anonymous", 0.9, 0.0, "static"), ("anonymous", 0.9, 0.5, "static"),
             ("anonymous", 0.9, 2.0, "static"), ("named", 1.0, 0.0, "all"),
             ("anonymous", 0.9, 0.5, "all")]
     lines = ["| scene | detections | detection prob. | false per frame | occlusion | people-frames | "
-             "missed | false tracks | identity switches | MOTA | MOTP [m] | tracks started |",
-             "|" + "---|" * 12]
+             "missed | false tracks | identity switches | MOTA | MOTP [m] | tracks started | "
+             "confirmed by |", "|" + "---|" * 13]
     for f in ("eth_hotel", "ucy_zara01"):
         tracks = read_obsmat(SHARED / "crowds" / f"{f}_obsmat.txt")
         for assoc, prob, clutter, occ in rows:
             r = evaluate_tracking(tracks, association=assoc, detection_prob=prob,
-                                  clutter_rate=clutter, occlusion=occ, tracker=tc, t_end=300.0)
+                                  clutter_rate=clutter, occlusion=occ, tracker=dict(tracker),
+                                  t_end=300.0)
             lines.append(f"| {f} | {assoc} | {prob:g} | {clutter:g} | {occ} | {r.gt} | {r.fn} | {r.fp} | "
-                         f"{r.id_switches} | {r.mota:.3f} | {r.motp_m:.3f} | {r.started} |")
+                         f"{r.id_switches} | {r.mota:.3f} | {r.motp_m:.3f} | {r.started} | "
+                         f"{r.confirm_hits} |")
     return "\n".join(lines)
 
 

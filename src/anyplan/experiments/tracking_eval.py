@@ -24,7 +24,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from anyplan.prediction.tracking import Tracker, TrackerConfig
-from anyplan.simulation.perception import Sensor
+from anyplan.simulation.perception import Sensor, tracking_configs
 from anyplan.world.motion import TrackMotion
 from anyplan.world.robot import RobotSpec, RobotState
 from anyplan.world.scenario import Scenario
@@ -37,8 +37,9 @@ __all__ = ["MotScores", "evaluate_tracking"]
 @dataclass(frozen=True)
 class MotScores:
     """CLEAR MOT counts over the frames (people-frames ``gt``; ``tp`` matched, ``fn`` missed,
-    ``fp`` confirmed tracks matched to no one, ``id_switches``), MOTA, MOTP [m], and the tracks
-    the tracker started (``started``)."""
+    ``fp`` confirmed tracks matched to no one, ``id_switches``), MOTA, MOTP [m], the tracks
+    the tracker started (``started``) and the detections that confirmed one
+    (``confirm_hits``)."""
 
     frames: int
     gt: int
@@ -49,6 +50,7 @@ class MotScores:
     mota: float
     motp_m: float
     started: int
+    confirm_hits: int
 
     def as_dict(self) -> dict[str, float]:
         """A JSON-friendly dictionary."""
@@ -77,10 +79,14 @@ def _scene(tracks: Mapping[int, np.ndarray], spec: SensingSpec, radius_m: float)
 def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "anonymous",
                       noise_m: float = 0.05, rate_hz: float = 10.0, detection_prob: float = 1.0,
                       clutter_rate: float = 0.0, occlusion: str = "static", seed: int = 0,
-                      radius_m: float = 0.25, tracker: TrackerConfig | None = None,
+                      radius_m: float = 0.25,
+                      tracker: TrackerConfig | Mapping[str, float] | None = None,
                       match_m: float = 0.5, t_end: float | None = None) -> MotScores:
     """CLEAR MOT scores of the tracker on ``tracks`` (person id -> rows (t, x, y)) from 0 s to
-    ``t_end`` [s] (default: the recording's end), the detections those of the robot's sensor
+    ``t_end`` [s] (default: the recording's end). ``tracker``: the tracker's settings as given,
+    or as names and values with the defaults of the robot's tracking front end (None: no
+    names; :func:`anyplan.simulation.perception.tracking_configs`, which tells it the sensor's
+    noise and its false detections over the scene). The detections are those of the robot's sensor
     in ``tracked`` mode seeded by ``seed``, seeing from the scene's centre (``occlusion:
     all``: the people nearer to it hide those behind them; a person hidden counts as missed).
 
@@ -94,7 +100,10 @@ def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "a
     scene = _scene(tracks, spec, radius_m)
     sensor = Sensor(scene, spec, seed)
     viewpoint = RobotState(*scene.robot.start)
-    tr = Tracker(tracker or TrackerConfig(sigma_m=noise_m))
+    if not isinstance(tracker, TrackerConfig):
+        tracker, _ = tracking_configs(tracker or {}, noise_m, spec=spec,
+                                      view_area_m2=scene.width * scene.height)
+    tr = Tracker(tracker)
 
     def expected(centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
         """The tracks the sensor should have seen: as the robot's tracking front end."""
@@ -130,4 +139,4 @@ def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "a
             last[pid] = est[r].name
     fn = gt - tp
     return MotScores(frames, gt, tp, fn, fp, idsw, 1.0 - (fn + fp + idsw) / max(gt, 1),
-                     dist / max(tp, 1), tr.started)
+                     dist / max(tp, 1), tr.started, round(tracker.confirm_hits))
