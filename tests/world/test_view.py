@@ -76,3 +76,19 @@ def test_an_occupancy_maps_walls_occlude(tmp_path):
     # behind its lower part
     assert view.visible((1.0, 2.5), c).tolist() == [False, True, True, False]
     assert FieldOfView(None, EMPTY).visible((1.0, 2.5), c).all()
+
+
+def test_a_margin_keeps_centres_near_the_views_edges_out_of_what_is_expected():
+    wall = ObstacleSet([rectangle((2.25, 0.0), (0.5, 2.0))])  # x in [2, 2.5], y in [-1, 1]
+    view = FieldOfView(6.0, wall)
+    o = (0.0, 0.0)
+    # clear by far; 5.9 m away: in range, not by 0.2 m; a line of sight passing 0.09 m from the
+    # wall's corner
+    c = np.array([[3.0, 3.0], [0.0, 5.9], [4.0, 2.2]])
+    assert view.visible(o, c).tolist() == [True, True, True]
+    assert view.visible(o, c, 0.2).tolist() == [True, False, False]
+    # a disc whose edge passes 0.1 m from the line of sight hides the other only with a margin
+    two = np.array([[1.0, 0.4], [3.0, 0.0]])
+    assert FieldOfView(None, EMPTY).expected(o, two, np.array([0.3, 0.3])).tolist() == [True, True]
+    assert FieldOfView(None, EMPTY).expected(o, two, np.array([0.3, 0.3]), 0.2).tolist() \
+        == [True, False]

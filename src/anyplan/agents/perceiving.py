@@ -103,12 +103,13 @@ class TrackingAgent(Agent):
                   odom: tuple[float, float, float] | None) -> Expected:
         """What the sensor should have seen of the tracks (in the tracker's frame, the odometry
         pose's when it differs from the believed one): their centres in view from the robot,
-        past the static obstacles and the other tracks' discs (:meth:`FieldOfView.expected`)."""
-        view = self._view
+        past the static obstacles and the other tracks' discs, with ``view_margin_m`` to spare
+        (:meth:`FieldOfView.expected`)."""
+        view, margin = self._view, self.tracker_config.view_margin_m
 
         def expected(centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
             c = centres if odom is None else _moved(centres, odom, believed)
-            return view.expected(believed[:2], c, radii)
+            return view.expected(believed[:2], c, radii, margin)
 
         return expected
 

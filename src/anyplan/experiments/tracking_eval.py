@@ -107,7 +107,8 @@ def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "a
 
     def expected(centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
         """The tracks the sensor should have seen: as the robot's tracking front end."""
-        return sensor.view.expected((viewpoint.x, viewpoint.y), centres, radii)
+        return sensor.view.expected((viewpoint.x, viewpoint.y), centres, radii,
+                                    tracker.view_margin_m)
 
     end = max(o.motion.span[1] for o in scene.moving_obstacles) if t_end is None else t_end
     last: dict[str, str] = {}

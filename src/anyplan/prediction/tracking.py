@@ -87,6 +87,10 @@ class TrackerConfig:
             evidence that the obstacle is gone (negative information; an obstacle that left or
             jumped), where a hidden one coasts up to ``drop_after_s``. Frames where the track
             is not expected neither count nor reset the count.
+        view_margin_m: A track is expected (``visible_misses``) only when its predicted centre
+            is in view with this to spare [m]: inside the range by it, clear of the static
+            obstacles and of the other tracks' discs by more (near the view's edges the
+            prediction and the truth may lie on either side).
     """
 
     sigma_m: float = setting(0.05, lo=0.0, unit="m", doc="measurement noise per axis")
@@ -117,6 +121,8 @@ class TrackerConfig:
                                     doc="anonymous: fastest an unconfirmed track may move")
     visible_misses: float = setting(3.0, lo=0.0, hi=1000.0, unit="",
                                     doc="frames missed in view that drop a track (0: never)")
+    view_margin_m: float = setting(0.2, lo=0.0, hi=10.0, unit="m",
+                                   doc="a track is expected in view only with this to spare")
 
     def __post_init__(self) -> None:
         validate(self)

@@ -49,34 +49,40 @@ class FieldOfView:
     range_m: float | None
     occluders: ObstacleSet
 
-    def line_of_sight(self, origin: tuple[float, float], centres: np.ndarray) -> np.ndarray:
+    def line_of_sight(self, origin: tuple[float, float], centres: np.ndarray,
+                      margin_m: float = 0.0) -> np.ndarray:
         """Mask (N,): centres (N, 2) [m] whose segment from ``origin`` (x, y) [m] clears every
-        occluder (exact)."""
+        occluder by more than ``margin_m`` [m] (exact)."""
         n = len(centres)
         if n == 0 or len(self.occluders) == 0:
             return np.ones(n, dtype=bool)
         a = np.tile(np.asarray(origin, dtype=float), (n, 1))
-        return self.occluders.segments_clearance(a, centres) > 0.0
+        return self.occluders.segments_clearance(a, centres) > margin_m
 
-    def visible(self, origin: tuple[float, float], centres: np.ndarray) -> np.ndarray:
-        """Mask (N,): centres (N, 2) [m] in range of ``origin`` (x, y) [m] and in line of sight."""
+    def visible(self, origin: tuple[float, float], centres: np.ndarray,
+                margin_m: float = 0.0) -> np.ndarray:
+        """Mask (N,): centres (N, 2) [m] in range of ``origin`` (x, y) [m] and in line of sight,
+        with ``margin_m`` [m] to spare (inside the range by it, clear of occluders by more)."""
         c = np.asarray(centres, dtype=float).reshape(-1, 2)
         keep = np.ones(len(c), dtype=bool)
         if self.range_m is not None:
-            keep &= np.hypot(c[:, 0] - origin[0], c[:, 1] - origin[1]) <= self.range_m
+            keep &= np.hypot(c[:, 0] - origin[0], c[:, 1] - origin[1]) <= self.range_m - margin_m
         idx = np.flatnonzero(keep)
-        keep[idx] = self.line_of_sight(origin, c[idx])
+        keep[idx] = self.line_of_sight(origin, c[idx], margin_m)
         return keep
 
     def expected(self, origin: tuple[float, float], centres: np.ndarray,
-                 radii: np.ndarray) -> np.ndarray:
+                 radii: np.ndarray, margin_m: float = 0.0) -> np.ndarray:
         """Mask (N,): the discs (centres (N, 2), radii (N,) [m]) whose centre is in view and
         whose line of sight no other of these discs crosses (the other disc nearer to
-        ``origin`` and its centre less than its radius from the segment: exact). What a tracker
-        may expect its sensor to detect, a person hidden behind another person not included."""
+        ``origin`` and its centre less than its radius from the segment: exact), with
+        ``margin_m`` [m] to spare on each test (:meth:`visible`; the other discs grown by it).
+        What a tracker may expect its sensor to detect, a person hidden behind another person
+        not included; a tracker's centres are predictions, and the margin keeps those near the
+        view's edges, where the truth may lie on the other side, out of its expectations."""
         c = np.asarray(centres, dtype=float).reshape(-1, 2)
-        r = np.asarray(radii, dtype=float)
-        out = self.visible(origin, c)
+        r = np.asarray(radii, dtype=float) + margin_m
+        out = self.visible(origin, c, margin_m)
         if len(c) < 2 or not out.any():
             return out
         o = np.asarray(origin, dtype=float)
