@@ -167,8 +167,8 @@ def _tracking(tracker: tuple[tuple[str, float], ...] = ()) -> str:
             ("anonymous", 0.9, 2.0, "static"), ("named", 1.0, 0.0, "all"),
             ("anonymous", 0.9, 0.5, "all")]
     lines = ["| scene | detections | detection prob. | false per frame | occlusion | people-frames | "
-             "missed | false tracks | identity switches | MOTA | MOTP [m] | tracks started | "
-             "confirmed by |", "|" + "---|" * 13]
+             "missed | false tracks | identity switches | MOTA | MOTP [m] | tracks started |",
+             "|" + "---|" * 12]
     for f in ("eth_hotel", "ucy_zara01"):
         tracks = read_obsmat(SHARED / "crowds" / f"{f}_obsmat.txt")
         for assoc, prob, clutter, occ in rows:
@@ -176,8 +176,7 @@ def _tracking(tracker: tuple[tuple[str, float], ...] = ()) -> str:
                                   clutter_rate=clutter, occlusion=occ, tracker=dict(tracker),
                                   t_end=300.0)
             lines.append(f"| {f} | {assoc} | {prob:g} | {clutter:g} | {occ} | {r.gt} | {r.fn} | {r.fp} | "
-                         f"{r.id_switches} | {r.mota:.3f} | {r.motp_m:.3f} | {r.started} | "
-                         f"{r.confirm_hits} |")
+                         f"{r.id_switches} | {r.mota:.3f} | {r.motp_m:.3f} | {r.started} |")
     return "\n".join(lines)
 
 

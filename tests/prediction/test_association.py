@@ -144,23 +144,3 @@ def test_named_and_anonymous_frames_repeat_exactly():
         runs.append([(e.name, e.state.tobytes()) for e in tr.estimates(6.0)])
     assert runs[0] == runs[1] and len(runs[0]) == 2
 
-
-def test_the_detections_that_confirm_a_track_grow_with_the_false_detections_density():
-    from anyplan.prediction.tracking import confirm_hits_for_clutter
-
-    cfg = TrackerConfig(sigma_m=0.05)
-    assert confirm_hits_for_clutter(cfg, 0.0, 10.0, 100.0) == 2  # no clutter: the setting
-    ns = [confirm_hits_for_clutter(cfg, lam, 10.0, 112.0) for lam in (0.1, 0.5, 2.0, 10.0, 50.0)]
-    assert ns == sorted(ns) and ns[0] == 2 and ns[2] == 3 and ns[-1] > ns[2]
-    # the rule's own bound: with n detections the false tracks confirmed per second are at most
-    # 0.1, and with n - 1 (when above the setting's 2) more than that
-    gate = cfg.init_max_speed / 10.0 + 4.0 * cfg.sigma_m
-    for lam, n in zip((0.1, 0.5, 2.0, 10.0, 50.0), ns, strict=True):
-        q = min(1.0, 3.0 * lam * np.pi * gate ** 2 / 112.0)
-        assert 10.0 * lam * q ** (n - 1) <= 0.1 or n == 5  # 5 at most
-        if n > 2:
-            assert 10.0 * lam * q ** (n - 2) > 0.1
-    assert ns[-1] == 5  # 50 false detections per frame on 112 m^2: q = 1, capped
-    # a larger view dilutes the same false detections
-    assert confirm_hits_for_clutter(cfg, 2.0, 10.0, 10000.0) == 2
-    assert confirm_hits_for_clutter(TrackerConfig(confirm_hits=4), 2.0, 10.0, 112.0) == 4

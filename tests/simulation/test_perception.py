@@ -419,20 +419,3 @@ def test_with_occlusion_all_a_disc_hides_what_is_behind_it():
     _, det = static.observe(0.0, RobotState(0.0, 0.5, 0.0))
     assert len(det) == 4 and "occlusion" not in static.record()
 
-
-def test_the_front_end_takes_its_confirmation_from_the_false_detections_density():
-    from anyplan.agents import make_agent
-    from anyplan.prediction.tracking import TrackerConfig, confirm_hits_for_clutter
-    from anyplan.simulation.perception import with_tracking
-
-    sc = _anonymous(prob=0.9, clutter=2.0)
-    area = sc.width * sc.height  # 48 m^2, no sensing range
-    ag = with_tracking(make_agent("straight"), sc.sensing, {}, area)
-    want = confirm_hits_for_clutter(TrackerConfig(sigma_m=0.05), 2.0, 10.0, area)
-    assert want > 2 and ag.tracker_config.confirm_hits == want
-    assert with_tracking(make_agent("straight"), sc.sensing, {"confirm_hits": 2.0}, area) \
-        .tracker_config.confirm_hits == 2  # given: kept
-    few = override_sensing(sc, clutter_rate=0.05)
-    assert with_tracking(make_agent("straight"), few.sensing, {}, area).tracker_config.confirm_hits == 2
-    named = override_sensing(scenario_from_dict(small_scenario_dict()), "tracked")
-    assert with_tracking(make_agent("straight"), named.sensing, {}, area).tracker_config.confirm_hits == 2

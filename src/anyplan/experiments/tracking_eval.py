@@ -37,9 +37,8 @@ __all__ = ["MotScores", "evaluate_tracking"]
 @dataclass(frozen=True)
 class MotScores:
     """CLEAR MOT counts over the frames (people-frames ``gt``; ``tp`` matched, ``fn`` missed,
-    ``fp`` confirmed tracks matched to no one, ``id_switches``), MOTA, MOTP [m], the tracks
-    the tracker started (``started``) and the detections that confirmed one
-    (``confirm_hits``)."""
+    ``fp`` confirmed tracks matched to no one, ``id_switches``), MOTA, MOTP [m], and the tracks
+    the tracker started (``started``)."""
 
     frames: int
     gt: int
@@ -50,7 +49,6 @@ class MotScores:
     mota: float
     motp_m: float
     started: int
-    confirm_hits: int
 
     def as_dict(self) -> dict[str, float]:
         """A JSON-friendly dictionary."""
@@ -86,7 +84,7 @@ def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "a
     ``t_end`` [s] (default: the recording's end). ``tracker``: the tracker's settings as given,
     or as names and values with the defaults of the robot's tracking front end (None: no
     names; :func:`anyplan.simulation.perception.tracking_configs`, which tells it the sensor's
-    noise and its false detections over the scene). The detections are those of the robot's sensor
+    noise). The detections are those of the robot's sensor
     in ``tracked`` mode seeded by ``seed``, seeing from the scene's centre (``occlusion:
     all``: the people nearer to it hide those behind them; a person hidden counts as missed).
 
@@ -101,8 +99,7 @@ def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "a
     sensor = Sensor(scene, spec, seed)
     viewpoint = RobotState(*scene.robot.start)
     if not isinstance(tracker, TrackerConfig):
-        tracker, _ = tracking_configs(tracker or {}, noise_m, spec=spec,
-                                      view_area_m2=scene.width * scene.height)
+        tracker, _ = tracking_configs(tracker or {}, noise_m)
     tr = Tracker(tracker)
 
     def expected(centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
@@ -140,4 +137,4 @@ def evaluate_tracking(tracks: Mapping[int, np.ndarray], *, association: str = "a
             last[pid] = est[r].name
     fn = gt - tp
     return MotScores(frames, gt, tp, fn, fp, idsw, 1.0 - (fn + fp + idsw) / max(gt, 1),
-                     dist / max(tp, 1), tr.started, round(tracker.confirm_hits))
+                     dist / max(tp, 1), tr.started)

@@ -27,16 +27,11 @@ from scipy.optimize import linear_sum_assignment
 from anyplan.config import setting, validate
 from anyplan.prediction.detection import Detection
 
-__all__ = ["TrackerConfig", "Tracker", "TrackEstimate", "ct_transition", "Expected",
-           "confirm_hits_for_clutter"]
+__all__ = ["TrackerConfig", "Tracker", "TrackEstimate", "ct_transition", "Expected"]
 
 #: What the sensor should have detected in a frame: predicted centres (N, 2) [m], radii (N,)
 #: [m] -> mask (N,).
 Expected = Callable[[np.ndarray, np.ndarray], np.ndarray]
-
-#: Most detections :func:`confirm_hits_for_clutter` asks for: beyond, a track would come too
-#: late to plan with (0.5 s at 10 Hz), and so much clutter needs a better detector.
-_MAX_CONFIRM = 5
 
 _H = np.zeros((2, 5))
 _H[0, 0] = _H[1, 1] = 1.0
@@ -126,30 +121,6 @@ class TrackerConfig:
 
     def __post_init__(self) -> None:
         validate(self)
-
-
-def confirm_hits_for_clutter(config: TrackerConfig, clutter_rate: float, rate_hz: float,
-                             view_area_m2: float, max_false_per_s: float = 0.1) -> int:
-    """The fewest detections (at least ``config.confirm_hits``) that confirm an anonymous track
-    when ``clutter_rate`` false detections per frame fall uniformly over ``view_area_m2`` [m^2]
-    at ``rate_hz`` [Hz], so that false tracks are confirmed at most ``max_false_per_s`` times a
-    second. Each false detection starts a young track; one more falls within its gate (radius
-    ``init_max_speed`` / rate + 4 sigma) in a frame of its patience (``tentative_drop_s``) with
-    probability about q = frames x clutter_rate x gate area / view area, so false tracks are
-    confirmed at about rate_hz x clutter_rate x q^(n-1) per second with n detections (track
-    initiation by an n-detection rule: Blackman & Popoli, *Design and Analysis of Modern
-    Tracking Systems*, 1999, section 6.3). Without clutter, ``config.confirm_hits``; at most 5
-    (or ``config.confirm_hits`` when more)."""
-    n = max(1, round(config.confirm_hits))
-    if clutter_rate <= 0.0 or view_area_m2 <= 0.0:
-        return n
-    gate = config.init_max_speed / rate_hz + 4.0 * max(config.sigma_m, 1e-3)
-    frames = max(1.0, config.tentative_drop_s * rate_hz)
-    q = min(1.0, frames * clutter_rate * math.pi * gate * gate / view_area_m2)
-    while n < _MAX_CONFIRM and rate_hz * clutter_rate * q ** (n - 1) > max_false_per_s:
-        n += 1
-    return n
-
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,7 @@ from anyplan.agents.perceiving import TrackingAgent
 from anyplan.errors import UnknownNameError
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.prediction.detection import Detection
-from anyplan.prediction.tracking import TrackerConfig, confirm_hits_for_clutter
+from anyplan.prediction.tracking import TrackerConfig
 from anyplan.prediction.uncertain import UNCERTAINTY_SETTINGS, UncertaintyModel
 from anyplan.world.robot import RobotState
 from anyplan.world.scenario import Scenario
@@ -212,18 +212,12 @@ def tracking_setting_names() -> tuple[str, ...]:
     return tuple(f.name for f in fields(TrackerConfig)) + UNCERTAINTY_SETTINGS
 
 
-def tracking_configs(settings: Mapping[str, float], noise_m: float, *,
-                     spec: SensingSpec | None = None, view_area_m2: float | None = None
+def tracking_configs(settings: Mapping[str, float], noise_m: float
                      ) -> tuple[TrackerConfig, UncertaintyModel]:
     """The tracker's settings and its uncertainty model from ``settings`` (name -> value; see
     :func:`tracking_setting_names`), the defaults elsewhere; the tracker's measurement noise
     ``sigma_m`` is the sensor's ``noise_m`` [m] unless ``settings`` gives it (a robot may not
-    know its sensor's noise exactly). Given the sensor's ``spec`` and the area it covers
-    (``view_area_m2`` [m^2], :func:`anyplan.world.view.view_area_m2`), anonymous detections
-    with false ones get the detections that confirm a track from the false detections' density
-    unless ``settings`` gives ``confirm_hits``
-    (:func:`~anyplan.prediction.tracking.confirm_hits_for_clutter`): a robot knows its
-    detector's false-positive rate as it knows its noise.
+    know its sensor's noise exactly).
 
     Raises:
         UnknownNameError: a name that is neither (with the nearest known one).
@@ -236,12 +230,7 @@ def tracking_configs(settings: Mapping[str, float], noise_m: float, *,
     tracker = {k: float(v) for k, v in settings.items() if k not in UNCERTAINTY_SETTINGS}
     tracker.setdefault("sigma_m", float(noise_m))
     disc = {k: float(v) for k, v in settings.items() if k in UNCERTAINTY_SETTINGS}
-    config = TrackerConfig(**tracker)
-    if spec is not None and view_area_m2 is not None and "confirm_hits" not in settings \
-            and spec.association == "anonymous" and spec.clutter_rate > 0.0:
-        n = confirm_hits_for_clutter(config, spec.clutter_rate, spec.rate_hz, view_area_m2)
-        config = replace(config, confirm_hits=float(n))
-    return config, UncertaintyModel(**disc)  # type: ignore[arg-type]
+    return TrackerConfig(**tracker), UncertaintyModel(**disc)  # type: ignore[arg-type]
 
 
 def parse_tracking_settings(items: Sequence[str]) -> tuple[tuple[str, float], ...]:
@@ -273,15 +262,12 @@ def parse_tracking_settings(items: Sequence[str]) -> tuple[tuple[str, float], ..
 
 
 def with_tracking(agent: Agent, spec: SensingSpec,
-                  settings: Mapping[str, float] | None = None,
-                  view_area_m2: float | None = None) -> Agent:
+                  settings: Mapping[str, float] | None = None) -> Agent:
     """``agent`` behind the tracking front end (:class:`~anyplan.agents.perceiving.TrackingAgent`,
-    its tracker told the sensor's noise, its false detections' density over ``view_area_m2``
-    [m^2] and the tracking ``settings``, :func:`tracking_configs`) when ``spec`` is
-    ``tracked``, unless the agent handles detections itself (``agent.handles_detections``) or
-    is wrapped already."""
+    its tracker told the sensor's noise and the tracking ``settings``,
+    :func:`tracking_configs`) when ``spec`` is ``tracked``, unless the agent handles detections
+    itself (``agent.handles_detections``) or is wrapped already."""
     if spec.mode != "tracked" or getattr(agent, "handles_detections", False) \
             or isinstance(agent, TrackingAgent):
         return agent
-    return TrackingAgent(agent, *tracking_configs(settings or {}, spec.noise_m, spec=spec,
-                                                  view_area_m2=view_area_m2))
+    return TrackingAgent(agent, *tracking_configs(settings or {}, spec.noise_m))

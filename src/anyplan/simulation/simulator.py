@@ -50,7 +50,6 @@ from anyplan.world.limits import MAX_SIM_STEPS, MAX_TIME_LIMIT_S, MIN_DT_S
 from anyplan.world.motion import Jump
 from anyplan.world.robot import Command, RobotState, step
 from anyplan.world.scenario import Scenario
-from anyplan.world.view import view_area_m2
 
 __all__ = ["SimConfig", "RunResult", "RunStatus", "Simulation", "simulate", "observe",
            "WALL_CLOCK_FIELDS", "without_wall_clock"]
@@ -380,7 +379,7 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
     wall0 = time.perf_counter()
     sim = Simulation(scenario, config, seed)
     wall_clock_extra = getattr(agent, "wall_clock_extra", ())
-    agent = with_tracking(agent, sim.sensor.spec, dict(sim.config.tracker), view_area_m2(scenario))
+    agent = with_tracking(agent, sim.sensor.spec, dict(sim.config.tracker))
     agent.stats = AgentStats()
     if not sim.unreachable:
         agent.reset(scenario.static_only(), np.random.default_rng(seed))

@@ -10,7 +10,6 @@ tell a track the sensor should have seen from one it could not (negative informa
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -21,7 +20,7 @@ from anyplan.geometry.collision import ObstacleSet
 if TYPE_CHECKING:
     from anyplan.world.scenario import Scenario
 
-__all__ = ["FieldOfView", "field_of_view", "view_area_m2"]
+__all__ = ["FieldOfView", "field_of_view"]
 
 
 def field_of_view(scenario: Scenario) -> FieldOfView:
@@ -32,14 +31,6 @@ def field_of_view(scenario: Scenario) -> FieldOfView:
     occluders = ObstacleSet(shapes) if scenario.static_map is None \
         else scenario.static_map.obstacle_set(shapes)
     return FieldOfView(scenario.robot.sensing_range, occluders)
-
-
-def view_area_m2(scenario: Scenario) -> float:
-    """The area [m^2] the robot's sensor covers at a time: the arena's, or the disc of
-    ``robot.sensing_range`` when that is smaller (shadows not deducted)."""
-    arena = scenario.width * scenario.height
-    r = scenario.robot.sensing_range
-    return arena if r is None else min(arena, math.pi * r * r)
 
 
 @dataclass(frozen=True)
