@@ -162,6 +162,7 @@ def _tracking(tracker: tuple[tuple[str, float], ...] = ()) -> str:
     (``occlusion: all``) (``anyplan.experiments.tracking_eval``)."""
     from anyplan.experiments.crowds import read_obsmat
     from anyplan.experiments.tracking_eval import evaluate_tracking
+
     rows = [("named", 1.0, 0.0, "static"), ("anonymous", 1.0, 0.0, "static"),
             ("anonymous", 0.9, 0.0, "static"), ("anonymous", 0.9, 0.5, "static"),
             ("anonymous", 0.9, 2.0, "static"), ("named", 1.0, 0.0, "all"),

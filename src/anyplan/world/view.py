@@ -79,8 +79,8 @@ class FieldOfView:
         o = np.asarray(origin, dtype=float)
         d = c - o                                   # (N, 2) segments origin -> centre i
         L2 = np.maximum(d[:, 0] ** 2 + d[:, 1] ** 2, 1e-18)
-        w = c[None, :, :] - o                       # (1, N, 2) origin -> centre j
-        s = (w[..., 0] * d[:, None, 0] + w[..., 1] * d[:, None, 1]) / L2[:, None]  # (i, j)
+        # (i, j): where on the segment to centre i the centre j projects, clipped to it
+        s = (d[None, :, 0] * d[:, None, 0] + d[None, :, 1] * d[:, None, 1]) / L2[:, None]
         s = np.clip(s, 0.0, 1.0)
         px = o[0] + s * d[:, None, 0] - c[None, :, 0]
         py = o[1] + s * d[:, None, 1] - c[None, :, 1]
