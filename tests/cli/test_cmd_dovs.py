@@ -35,3 +35,11 @@ def test_dovs_plot_bad_input(argv, needle, capsys, tmp_path, monkeypatch) -> Non
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert needle in err and err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_dovs_plot_offers_only_the_keys_a_value_can_set(capsys, tmp_path, monkeypatch) -> None:
+    # the robot's limits are the scenario's: no command-line value can be a RobotLimits
+    monkeypatch.chdir(tmp_path)
+    assert main(["dovs-plot", "paper-1", "--time", "1", "--set", "limits=1"]) == 2
+    err = capsys.readouterr().err
+    assert "expected KEY=VALUE with KEY one of" in err and "limits" not in err.split("one of")[1]

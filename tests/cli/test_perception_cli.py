@@ -55,7 +55,8 @@ def test_run_records_anonymous_detections_and_clutter(tmp_path):
 
 @pytest.mark.parametrize(("item", "words"), [
     ("q_c=0.01", "--tracker: unknown tracker setting 'q_c'; did you mean 'q_cv'?"),
-    ("q_cv=-1", "--tracker: TrackerConfig.q_cv: must be > 0"),
+    ("q_cv=-1", "--tracker: TrackerConfig.q_cv: must be in (0, 10000]"),
+    ("sigma_m=1e300", "--tracker: TrackerConfig.sigma_m: must be in [0, 10] m"),
     ("turn_confidence=2", "--tracker: UncertaintyModel.turn_confidence: must be in [0, 1]"),
     ("k_sigma=two", "--tracker: k_sigma: expected a number, got 'two'"),
     ("k_sigma", "--tracker: expected KEY=VALUE, got 'k_sigma'"),

@@ -110,3 +110,16 @@ def test_discovery_skips_taken_names_and_bad_values(monkeypatch, caplog):
     with pytest.raises(LoadError,
                        match=r"planner 'gone' \(plugin from x 1: json:NoSuchThing\).*AttributeError"):
         reg.get("gone")
+
+
+def test_a_plugin_claiming_a_built_in_name_is_warned_about_on_the_command_line(tmp_path):
+    # the warning is logged while the parser is built (plugin discovery), before the options
+    # are read: the command line must have set up logging by then, or it is lost
+    dist = tmp_path / "site" / "shadow_pkg-0.1.dist-info"
+    dist.mkdir(parents=True)
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: shadow-pkg\nVersion: 0.1\n")
+    (dist / "entry_points.txt").write_text("[anyplan.agents]\nstraight = shadow_nowhere:Agent\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path / "site"), str(ROOT / "src")]))
+    p = _anyplan(env, "planners", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert "shadow-pkg" in p.stderr and "straight" in p.stderr and "the name is taken" in p.stderr

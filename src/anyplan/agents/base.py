@@ -26,7 +26,7 @@ from anyplan.world.robot import Command, RobotState
 from anyplan.world.scenario import Scenario
 
 __all__ = ["Observation", "Agent", "AgentStats", "TrackingLog", "TrackedStats", "AGENTS",
-           "make_agent", "checked_pose_margin"]
+           "make_agent", "checked_number", "checked_pose_margin"]
 
 
 @dataclass(frozen=True)
@@ -163,6 +163,29 @@ AGENTS.register("orca", "anyplan.agents.orca:ORCAAgent")  # optional extra: pyrv
 AGENTS.register("policy", "anyplan.agents.policy:PolicyAgent")  # e.g. trained in anyplan.gym
 
 
+def checked_number(name: str, value: Any, lo: float = 0.0, *, lo_open: bool = False) -> float:
+    """An agent's numeric setting ``name``: ``value`` as a float when it is a finite number
+    >= ``lo`` (> ``lo`` with ``lo_open``), so that a bad ``--set`` value is refused when the
+    agent is built, not met halfway through a run.
+
+    Raises:
+        ValueError: anything else (the message names the setting).
+
+    Examples:
+        >>> checked_number("period_s", 0.1, lo_open=True)
+        0.1
+        >>> checked_number("period_s", 0.0, lo_open=True)
+        Traceback (most recent call last):
+        ...
+        ValueError: period_s: must be > 0, got 0.0
+    """
+    ok = (isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+          and (value > lo if lo_open else value >= lo))
+    if not ok:
+        raise ValueError(f"{name}: must be {'>' if lo_open else '>='} {lo:g}, got {value!r}")
+    return float(value)
+
+
 def checked_pose_margin(value: Any) -> float:
     """The ``pose_margin_m`` setting [m] of the agents that keep clearance for a localization
     error (``seq-bitstar``, ``st-bitstar``, ``bitstar``).
@@ -170,9 +193,7 @@ def checked_pose_margin(value: Any) -> float:
     Raises:
         ValueError: not a finite number >= 0 (the message names the setting).
     """
-    if not (isinstance(value, int | float) and 0.0 <= value < math.inf):
-        raise ValueError(f"pose_margin_m: must be >= 0, got {value!r}")
-    return float(value)
+    return checked_number("pose_margin_m", value)
 
 
 def _discover(registry: Registry[type[Agent]]) -> None:

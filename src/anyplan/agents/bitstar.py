@@ -19,7 +19,14 @@ import time
 
 import numpy as np
 
-from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog, checked_pose_margin
+from anyplan.agents.base import (
+    Agent,
+    AgentStats,
+    Observation,
+    TrackingLog,
+    checked_number,
+    checked_pose_margin,
+)
 from anyplan.agents.stats import BITStarStats
 from anyplan.agents.warmup import warm_up_kernels
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
@@ -68,7 +75,7 @@ class BITStarAgent(Agent):
         self.smooth_margin = float(smooth_margin)
         self.max_attempts = int(max_attempts)
         self.gains = gains or KanayamaGains()
-        self.control_dt = float(control_dt)
+        self.control_dt = checked_number("control_dt", control_dt, lo_open=True)
         self.trajectory: Trajectory | None = None
 
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:

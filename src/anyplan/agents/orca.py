@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from anyplan.agents.base import Agent, Observation
+from anyplan.agents.base import Agent, Observation, checked_number
 from anyplan.geometry.se2 import wrap_angle
 from anyplan.geometry.shapes import Circle, Polygon
 from anyplan.planning.api import plan
@@ -62,13 +62,16 @@ class ORCAAgent(Agent):
         super().__init__()
         import pyrvo  # noqa: F401  (fail at construction when the extra is missing)
 
-        self.period_s = period_s
-        self.time_horizon_s = time_horizon_s
-        self.time_horizon_obst_s = time_horizon_obst_s
-        self.neighbor_dist_m = neighbor_dist_m
+        self.period_s = checked_number("period_s", period_s, lo_open=True)
+        self.time_horizon_s = checked_number("time_horizon_s", time_horizon_s, lo_open=True)
+        self.time_horizon_obst_s = checked_number("time_horizon_obst_s", time_horizon_obst_s,
+                                                  lo_open=True)
+        self.neighbor_dist_m = checked_number("neighbor_dist_m", neighbor_dist_m, lo_open=True)
+        if isinstance(max_neighbors, bool) or not isinstance(max_neighbors, int) or max_neighbors < 1:
+            raise ValueError(f"max_neighbors: must be an integer >= 1, got {max_neighbors!r}")
         self.max_neighbors = max_neighbors
-        self.safety_m = safety_m
-        self.uncertainty_horizon_s = uncertainty_horizon_s
+        self.safety_m = checked_number("safety_m", safety_m)
+        self.uncertainty_horizon_s = checked_number("uncertainty_horizon_s", uncertainty_horizon_s)
 
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
         self.stats.planning_times_s.clear()

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog
+from anyplan.agents.base import Agent, AgentStats, Observation, TrackingLog, checked_number
 from anyplan.agents.stats import SequentialStats
 from anyplan.control.kanayama import KanayamaController, KanayamaGains
 from anyplan.geometry.se2 import wrap_angle
@@ -72,10 +72,10 @@ class ReplanningAgent(Agent):
                                                  and planning_delay >= 0.0):
             raise ValueError(f"planning_delay: 'measured' or a delay >= 0 s, got {planning_delay!r}")
         self.check_period_s = float(check_period_s)
-        self.min_replan_interval_s = float(min_replan_interval_s)
-        self.urgent_s = float(urgent_s)
+        self.min_replan_interval_s = checked_number("min_replan_interval_s", min_replan_interval_s)
+        self.urgent_s = checked_number("urgent_s", urgent_s)
         self.planning_delay = planning_delay
-        self.max_delay_s = float(max_delay_s)
+        self.max_delay_s = checked_number("max_delay_s", max_delay_s, lo_open=True)
         self.gains = gains or KanayamaGains()
         if reanchor_m is not None and not (isinstance(reanchor_m, int | float) and reanchor_m > 0.0):
             raise ValueError(f"reanchor_m: must be > 0 or null, got {reanchor_m!r}")

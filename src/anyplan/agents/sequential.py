@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from anyplan.agents.base import Observation, checked_pose_margin
+from anyplan.agents.base import Observation, checked_number, checked_pose_margin
 from anyplan.agents.replanning import MAX_BACKOFF_S, ReplanningAgent
 from anyplan.agents.safety import SafetyConfig, SafetyGuard
 from anyplan.agents.stats import SequentialStats
@@ -61,6 +61,7 @@ class SequentialBITStarAgent(ReplanningAgent):
         safety_config: Its settings (default: margin = the loop's ``margin``).
         reanchor_m: Tracking error [m] beyond which the next motion starts from the robot's
             own state (:class:`~anyplan.agents.replanning.ReplanningAgent`); None: never.
+        max_delay_s: Cap [s] on a measured planning delay; None: the loop's ``max_time_s``.
     """
 
     name = "seq-bitstar"
@@ -79,7 +80,8 @@ class SequentialBITStarAgent(ReplanningAgent):
                  planning_delay: str | float = "measured", grid_step: float = 0.05,
                  gains: KanayamaGains | None = None, safety: bool = True,
                  safety_config: SafetyConfig | None = None, reanchor_m: float | None = 0.2,
-                 pose_margin_m: float = 0.0, **loop_options: Any) -> None:
+                 pose_margin_m: float = 0.0, max_delay_s: float | None = None,
+                 **loop_options: Any) -> None:
         if config is None:
             config = SequentialConfig(**loop_options)
         elif loop_options:
@@ -89,13 +91,14 @@ class SequentialBITStarAgent(ReplanningAgent):
         pose_margin_m = checked_pose_margin(pose_margin_m)
         super().__init__(check_period_s=check_period_s,
                          min_replan_interval_s=min_replan_interval_s, urgent_s=urgent_s,
-                         planning_delay=planning_delay, max_delay_s=config.max_time_s,
+                         planning_delay=planning_delay,
+                         max_delay_s=config.max_time_s if max_delay_s is None else max_delay_s,
                          gains=gains, reanchor_m=reanchor_m)
         self.config = config
         self.plan_margin = float(plan_margin)
         self.smooth_margin = float(smooth_margin)
         self.pose_margin_m = pose_margin_m
-        self.grid_step = float(grid_step)
+        self.grid_step = checked_number("grid_step", grid_step, lo_open=True)
         self.safety = bool(safety)
         self.safety_config = safety_config or SafetyConfig(margin=config.margin,
                                                            recheck_margin=0.5 * config.margin)

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from anyplan.agents.base import Agent, Observation
+from anyplan.agents.base import Agent, Observation, checked_number
 from anyplan.geometry.se2 import wrap_angle
 from anyplan.world.robot import Command
 from anyplan.world.scenario import Scenario
@@ -31,8 +31,8 @@ class StraightAgent(Agent):
 
     def __init__(self, heading_gain: float = 2.0, align_tolerance: float = 0.05) -> None:
         super().__init__()
-        self.heading_gain = heading_gain
-        self.align_tolerance = align_tolerance
+        self.heading_gain = checked_number("heading_gain", heading_gain, lo_open=True)
+        self.align_tolerance = checked_number("align_tolerance", align_tolerance)
 
     def reset(self, scenario: Scenario, rng: np.random.Generator) -> None:
         self.spec = scenario.robot

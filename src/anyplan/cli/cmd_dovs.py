@@ -34,7 +34,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _parse_params(items: list[str]) -> dict[str, Any]:
     from anyplan.baselines.dovs.config import DOVSConfig
 
-    names = DOVSConfig.field_names()
+    # the robot's limits come from the scenario (a RobotLimits, not a value of the command line)
+    names = [n for n in DOVSConfig.field_names() if n != "limits"]
     out: dict[str, Any] = {}
     for item in items:
         key, sep, raw = item.partition("=")

@@ -69,10 +69,13 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code (0 success, 1 failure, 2 bad input)."""
     pick_headless_backend()  # Agg for the commands that draw, unless the user chose a backend
+    # logging first: building the parser finds the plugins, whose refusals are warnings
+    configured = not logging.getLogger().handlers
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     parser = build_parser()
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.WARNING - 10 * min(args.verbose, 2),
-                        format="%(levelname)s %(name)s: %(message)s")
+    if configured:  # an application that set up logging keeps its level
+        logging.getLogger().setLevel(logging.WARNING - 10 * min(args.verbose, 2))
     try:
         return int(args.func(args))
     except AnyplanError as exc:

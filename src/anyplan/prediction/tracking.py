@@ -24,7 +24,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from anyplan.config import setting, validate
+from anyplan.config import SettingError, setting, validate
 from anyplan.prediction.detection import Detection
 
 __all__ = ["TrackerConfig", "Tracker", "TrackEstimate", "ct_transition", "Expected"]
@@ -88,31 +88,31 @@ class TrackerConfig:
             prediction and the truth may lie on either side).
     """
 
-    sigma_m: float = setting(0.05, lo=0.0, unit="m", doc="measurement noise per axis")
-    q_cv: float = setting(0.05, lo=0.0, lo_open=True, unit="m^2/s^3", doc="CV acceleration noise")
-    q_ct: float = setting(0.05, lo=0.0, lo_open=True, unit="m^2/s^3", doc="CT acceleration noise")
-    q_omega: float = setting(0.02, lo=0.0, lo_open=True, unit="rad^2/s^3",
+    sigma_m: float = setting(0.05, lo=0.0, hi=10.0, unit="m", doc="measurement noise per axis")
+    q_cv: float = setting(0.05, lo=0.0, lo_open=True, hi=1e4, unit="m^2/s^3", doc="CV acceleration noise")
+    q_ct: float = setting(0.05, lo=0.0, lo_open=True, hi=1e4, unit="m^2/s^3", doc="CT acceleration noise")
+    q_omega: float = setting(0.02, lo=0.0, lo_open=True, hi=1e3, unit="rad^2/s^3",
                              doc="CT turn-rate random walk")
-    switch_rate: float = setting(0.5, lo=0.0, unit="1/s", doc="model switching rate")
-    init_speed_sigma: float = setting(1.0, lo=0.0, lo_open=True, unit="m/s",
+    switch_rate: float = setting(0.5, lo=0.0, hi=1e3, unit="1/s", doc="model switching rate")
+    init_speed_sigma: float = setting(1.0, lo=0.0, lo_open=True, hi=100.0, unit="m/s",
                                       doc="velocity sigma of a new track")
-    drop_after_s: float = setting(2.0, lo=0.0, lo_open=True, unit="s",
+    drop_after_s: float = setting(2.0, lo=0.0, lo_open=True, hi=3600.0, unit="s",
                                   doc="a track unseen this long is dropped")
-    gate_m: float = setting(1.0, lo=0.0, lo_open=True, unit="m",
+    gate_m: float = setting(1.0, lo=0.0, lo_open=True, hi=100.0, unit="m",
                             doc="a detection this far outside the gate restarts its track")
-    gate_chi2: float = setting(25.0, lo=0.0, lo_open=True, unit="",
+    gate_chi2: float = setting(25.0, lo=0.0, lo_open=True, hi=1e6, unit="",
                                doc="squared Mahalanobis gate of the restart")
-    manoeuvre_chi2: float = setting(9.2, lo=0.0, lo_open=True, unit="",
+    manoeuvre_chi2: float = setting(9.2, lo=0.0, lo_open=True, hi=1e6, unit="",
                                     doc="squared Mahalanobis distance that marks a manoeuvre")
-    q_manoeuvre: float = setting(50.0, lo=0.0, unit="m^2/s^3",
+    q_manoeuvre: float = setting(50.0, lo=0.0, hi=1e6, unit="m^2/s^3",
                                  doc="acceleration noise added at a manoeuvre")
     confirm_hits: float = setting(2.0, lo=1.0, hi=100.0, unit="",
                                   doc="anonymous: detections that confirm a track")
-    tentative_drop_s: float = setting(0.3, lo=0.0, lo_open=True, unit="s",
+    tentative_drop_s: float = setting(0.3, lo=0.0, lo_open=True, hi=3600.0, unit="s",
                                       doc="anonymous: patience per confirm_hits detections")
-    urgent_gap_m: float = setting(1.0, lo=0.0, unit="m",
+    urgent_gap_m: float = setting(1.0, lo=0.0, hi=100.0, unit="m",
                                   doc="anonymous: young tracks this near the robot are shown")
-    init_max_speed: float = setting(3.0, lo=0.0, lo_open=True, unit="m/s",
+    init_max_speed: float = setting(3.0, lo=0.0, lo_open=True, hi=100.0, unit="m/s",
                                     doc="anonymous: fastest an unconfirmed track may move")
     visible_misses: float = setting(3.0, lo=0.0, hi=1000.0, unit="",
                                     doc="frames missed in view that drop a track (0: never)")
@@ -121,6 +121,10 @@ class TrackerConfig:
 
     def __post_init__(self) -> None:
         validate(self)
+        for name in ("confirm_hits", "visible_misses"):  # counts, kept floats like the others
+            if not float(getattr(self, name)).is_integer():
+                raise SettingError("TrackerConfig", name,
+                                   f"must be a whole number, got {getattr(self, name)!r}")
 
 
 @dataclass(frozen=True)
@@ -481,16 +485,16 @@ class Tracker:
             self.missed = np.where(hit, 0, self.missed + (seen_by_sensor & ~hit))
         for d, named in new:
             self._add(d, named)
-        self.confirmed |= self.n >= round(self.config.confirm_hits)
+        self.confirmed |= self.n >= int(self.config.confirm_hits)
         cfg = self.config
         # anonymous tracks earn their patience: tentative_drop_s per confirm_hits detections,
         # up to drop_after_s (a false track confirmed by chance dies as fast as a young one)
-        earned = np.clip(cfg.tentative_drop_s * self.n / round(cfg.confirm_hits),
+        earned = np.clip(cfg.tentative_drop_s * self.n / int(cfg.confirm_hits),
                          cfg.tentative_drop_s, cfg.drop_after_s)
         patience = np.where(self.born_named, cfg.drop_after_s, earned)
         keep = t - self.last_seen <= patience + 1e-9
         if cfg.visible_misses > 0.0:
-            gone = self.missed >= round(cfg.visible_misses)
+            gone = self.missed >= int(cfg.visible_misses)
             self.vanished += int((gone & keep).sum())
             keep &= ~gone
         if not keep.all():

@@ -46,13 +46,13 @@ class UncertaintyModel:
     Invalid values raise :class:`~anyplan.config.SettingError` naming the field.
     """
 
-    k_sigma: float = setting(2.0, lo=0.0, unit="", doc="standard deviations of position covered")
-    accel_allowance: float = setting(0.1, lo=0.0, unit="m/s^2", doc="manoeuvre allowance")
-    cap_m: float = setting(1.0, lo=0.0, unit="m", doc="largest extra radius")
+    k_sigma: float = setting(2.0, lo=0.0, hi=100.0, unit="", doc="standard deviations of position covered")
+    accel_allowance: float = setting(0.1, lo=0.0, hi=100.0, unit="m/s^2", doc="manoeuvre allowance")
+    cap_m: float = setting(1.0, lo=0.0, hi=100.0, unit="m", doc="largest extra radius")
     taus: tuple[float, ...] = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0)
     turn_confidence: float = setting(0.7, lo=0.0, hi=1.0, unit="",
                                      doc="P(CT) from which the turn rate is predicted")
-    tube_cap_m: float = setting(0.3, lo=0.0, unit="m",
+    tube_cap_m: float = setting(0.3, lo=0.0, hi=100.0, unit="m",
                                 doc="largest extra radius of the replan tube")
 
     def __post_init__(self) -> None:
