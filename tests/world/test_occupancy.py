@@ -4,6 +4,7 @@ scenario's `static_map` key, and every bad-map case (one line naming file and fi
 from __future__ import annotations
 
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -212,6 +213,10 @@ FREE = np.full((1, 3), 255)
     (GOOD + "colour: 1\n", FREE, "m.yaml: colour", "unknown key"),
     (GOOD.replace("negate: 0\n", ""), FREE, "m.yaml: negate", "missing required key"),
     (GOOD + "negate: 1\n", FREE, "m.yaml", "duplicate key"),
+    (GOOD.replace("resolution: 1.0", "resolution: 1" + "0" * 400), FREE, "m.yaml: resolution",
+     "number too large"),
+    (GOOD.replace("[0, 0, 0]", "[100000, 0, 0]"), FREE, "m.yaml: origin[0]",
+     "must be within +-10000 (the stated limit)"),
     (GOOD, np.array([[255, 255, 255], [0, 255, 255]]), "s.yaml: robot.start",
      "occupied or unknown cell"),
     (GOOD, np.array([[255, 255, 205]]), "s.yaml: robot.goal", "occupied or unknown cell"),
@@ -251,3 +256,160 @@ def test_arena_required_without_map(tmp_path):
     f.write_text("name: s\n" + ROBOT)
     with pytest.raises(ScenarioError, match="arena: missing required key"):
         load_scenario(f)
+
+
+# --------------------------------------------------------------------------------------------
+# Values beyond the float range or the stated limits, huge pixels, image-size bombs, negate
+# --------------------------------------------------------------------------------------------
+BIG = "1" + "0" * 400  # an integer beyond the float range
+
+
+def _load_error(path: Path) -> ScenarioError:
+    with pytest.raises(ScenarioError) as ei:
+        load_map(path)
+    msg = str(ei.value)
+    assert "\n" not in msg and msg.startswith(f"{path}: "), msg
+    return ei.value
+
+
+@pytest.mark.parametrize(("old", "new", "fld"), [
+    ("resolution: 1.0", f"resolution: {BIG}", "resolution"),
+    ("occupied_thresh: 0.65", f"occupied_thresh: {BIG}", "occupied_thresh"),
+    ("free_thresh: 0.196", f"free_thresh: {BIG}", "free_thresh"),
+    ("[0, 0, 0]", f"[{BIG}, 0, 0]", "origin[0]"),
+    ("[0, 0, 0]", f"[0, -{BIG}, 0]", "origin[1]"),
+])
+def test_numbers_beyond_the_float_range_name_the_field(tmp_path, old, new, fld):
+    write_pgm(tmp_path / "m.pgm", FREE)
+    f = tmp_path / "m.yaml"
+    f.write_text(GOOD.replace(old, new))
+    exc = _load_error(f)
+    assert exc.field == fld and "number too large" in str(exc), exc
+
+
+@pytest.mark.parametrize(("origin", "fld"), [
+    ("[100000, 0, 0]", "origin[0]"), ("[0, -10000.5, 0]", "origin[1]"),
+    ("[1e17, 0, 0]", "origin[0]"), ("[1e300, 0, 0]", "origin[0]"),
+])
+def test_origin_beyond_the_coordinate_limit_is_refused(tmp_path, origin, fld):
+    write_pgm(tmp_path / "m.pgm", FREE)
+    f = tmp_path / "m.yaml"
+    f.write_text(GOOD.replace("[0, 0, 0]", origin))
+    exc = _load_error(f)
+    assert exc.field == fld and "within +-10000 (the stated limit)" in str(exc), exc
+
+
+def test_origin_limit_holds_with_an_explicit_arena(tmp_path):
+    # the map 100 km away from a 4 x 2 m arena used to be accepted silently
+    f = _scenario(tmp_path, GOOD.replace("[0, 0, 0]", "[100000, 0, 0]"), FREE)
+    f.write_text(f.read_text().replace("static_map:", "arena: {width: 4, height: 2}\nstatic_map:"))
+    with pytest.raises(ScenarioError, match=r"m\.yaml: origin\[0\]: must be within \+-10000"):
+        load_scenario(f)
+
+
+@pytest.mark.parametrize(("res", "origin", "words"), [
+    ("5000", "[0, 0, 0]", "far corner (15000, 5000) is beyond the coordinate limit"),  # 3 x 1 cells
+    ("1e300", "[0, 0, 0]", "beyond the coordinate limit"),
+    ("0.5", "[9999, -9999.5, 0]", "far corner (10000.5, -9999) is beyond"),
+    ("1e-300", "[1, 0, 0]", "must be >= 1e-06 (the stated limit)"),  # cells too small to tell apart
+])
+def test_map_extent_and_resolution_limits_name_resolution(tmp_path, res, origin, words):
+    write_pgm(tmp_path / "m.pgm", FREE)
+    f = tmp_path / "m.yaml"
+    f.write_text(GOOD.replace("resolution: 1.0", f"resolution: {res}").replace("[0, 0, 0]", origin))
+    exc = _load_error(f)
+    assert exc.field == "resolution" and words in str(exc), exc
+
+
+def test_map_at_the_coordinate_limit_is_accepted(tmp_path):
+    write_pgm(tmp_path / "m.pgm", FREE)
+    f = tmp_path / "m.yaml"
+    f.write_text(GOOD.replace("[0, 0, 0]", "[9997, -10000, 0]"))
+    assert load_map(f).bounds == (9997.0, -10000.0, 10000.0, -9999.0)
+
+
+@pytest.mark.parametrize("value", ["99999999999999999999999999", "-99999999999999999999999999"])
+def test_p2_pixel_beyond_int64_is_refused_naming_the_image(tmp_path, value):
+    (tmp_path / "m.pgm").write_bytes(f"P2\n2 2\n255\n1 2 3 {value}\n".encode())
+    with pytest.raises(ValueError, match=r"pixel values outside 0\.\.255"):
+        read_pgm(tmp_path / "m.pgm")
+    f = tmp_path / "m.yaml"
+    f.write_text(GOOD)
+    exc = _load_error(f)
+    assert exc.field == "image" and "m.pgm: pixel values outside 0..255" in str(exc), exc
+
+
+def png_header(width: int, height: int) -> bytes:
+    """A PNG of one 8-bit grey IHDR chunk (no pixel data) declaring ``width`` x ``height``."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IEND", b"")
+
+
+@pytest.mark.parametrize(("w", "h"), [(20000, 20000), (10000, 10000), (64001, 1000), (2**31 - 1, 2)])
+def test_png_header_beyond_the_size_limit_is_refused_before_decoding(tmp_path, w, h):
+    (tmp_path / "m.png").write_bytes(png_header(w, h))
+    f = tmp_path / "m.yaml"
+    f.write_text(GOOD.replace("m.pgm", "m.png"))
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        exc = _load_error(f)
+    assert exc.field == "image" and f"image {w} x {h} has more than 64000000 pixels" in str(exc), exc
+    assert not seen, [str(w.message) for w in seen]  # no DecompressionBombWarning
+
+
+def test_png_bomb_header_exits_2_with_one_line(tmp_path, capsys):
+    (tmp_path / "m.png").write_bytes(png_header(20000, 20000))
+    f = _scenario(tmp_path, GOOD.replace("m.pgm", "m.png"))
+    with pytest.raises(SystemExit) as ei:
+        sys.exit(main(["plan", str(f), "--planner", "visgraph"]))
+    assert ei.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "m.yaml: image:" in err and "more than 64000000" in err, err
+
+
+@pytest.mark.parametrize("pillow_limit", [4, 2])
+def test_pillow_size_limit_neither_warns_nor_raises_its_own_error(tmp_path, monkeypatch, pillow_limit):
+    # 3 x 2 = 6 pixels: above 4 Pillow warns, above 2 x 2 it raises DecompressionBombError
+    from PIL import Image
+
+    write_png(tmp_path / "m.png", IMG, "L")
+    monkeypatch.setattr(Image, "MAX_IMAGE_PIXELS", pillow_limit)
+    f = write_yaml(tmp_path / "m.yaml", "m.png")
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        if pillow_limit == 4:
+            assert load_map(f).shape == (2, 3)
+        else:
+            exc = _load_error(f)
+            assert exc.field == "image" and "image 3 x 2 is beyond Pillow's size limit" in str(exc)
+    assert not seen, [str(w.message) for w in seen]
+
+
+def test_png_without_ihdr_first_is_refused(tmp_path):
+    (tmp_path / "m.png").write_bytes(png_header(3, 2)[:16])  # cut inside the IHDR chunk
+    f = tmp_path / "m.yaml"
+    f.write_text(GOOD.replace("m.pgm", "m.png"))
+    exc = _load_error(f)
+    assert exc.field == "image" and "m.png: bad PNG header (no IHDR chunk" in str(exc), exc
+
+
+@pytest.mark.parametrize(("text", "same_as"), [("true", 1), ("false", 0), ("yes", 1), ("off", 0)])
+def test_negate_accepts_yaml_booleans_as_nav2_does(tmp_path, text, same_as):
+    # Nav2's map_io reads negate as an int, else as a bool: a map Nav2 loads loads here too
+    write_pgm(tmp_path / "m.pgm", IMG)
+    ref = load_map(write_yaml(tmp_path / "ref.yaml", "m.pgm", negate=same_as))
+    m = load_map(write_yaml(tmp_path / "m.yaml", "m.pgm", negate=text))
+    assert m.negate is bool(same_as) and m.values.tolist() == ref.values.tolist()
+
+
+@pytest.mark.parametrize("text", ["1.0", "0.0", "2", "-1", "'1'", "null"])
+def test_negate_other_than_0_1_or_a_boolean_is_refused(tmp_path, text):
+    write_pgm(tmp_path / "m.pgm", IMG)
+    exc = _load_error(write_yaml(tmp_path / "m.yaml", "m.pgm", negate=text))
+    assert exc.field == "negate" and "expected 0 or 1 (or true/false)" in str(exc), exc

@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import hashlib
 import math
+import struct
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,16 +22,22 @@ from typing import Any
 
 import numpy as np
 
-from anyplan.errors import ScenarioError
+from anyplan.errors import ScenarioError, shorten
 from anyplan.geometry.cells import cell_boxes, merge_cells
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.shapes import Shape
+from anyplan.world.limits import MAX_COORD_M
+from anyplan.world.schema import Ctx
 from anyplan.world.yaml_load import YamlLimitError, load_yaml
 
-__all__ = ["OccupancyMap", "load_map", "read_pgm", "read_image", "MAX_CELLS"]
+__all__ = ["OccupancyMap", "load_map", "read_pgm", "read_image", "MAX_CELLS", "MIN_RESOLUTION_M"]
 
-#: Largest map accepted, in cells (a 100 m x 100 m map at 0.02 m is 25 million cells).
+#: Largest map accepted, in cells (a 100 m x 100 m map at 0.02 m is 25 million cells); an image
+#: whose header declares more pixels is refused before its pixels are read.
 MAX_CELLS = 64_000_000
+#: Smallest cell side [m]: finer cells near the coordinate limit would round to empty boxes.
+MIN_RESOLUTION_M = 1e-6
+_PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 _MODES = ("trinary", "scale", "raw")
 _REQUIRED = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh")
@@ -181,6 +189,8 @@ def read_pgm(path: str | Path) -> tuple[np.ndarray, int]:
     else:
         try:
             vals = np.array(body.split(), dtype=np.int64)
+        except OverflowError:  # an integer beyond int64 (numpy raises this, not ValueError)
+            raise ValueError(f"pixel values outside 0..{maxval}") from None
         except ValueError:
             raise ValueError("bad P2 pixel data (not integers)") from None
         if len(vals) != w * h:
@@ -200,13 +210,39 @@ def read_image(path: str | Path) -> tuple[np.ndarray, np.ndarray | None]:
     if head[:2] in (b"P2", b"P5"):
         px, maxval = read_pgm(p)
         return px.astype(float) * (255.0 / maxval), None
-    if head != b"\x89PNG\r\n\x1a\n":
+    if head != _PNG_MAGIC:
         raise ValueError("unsupported image format (expected PGM P2/P5 or PNG)")
+    w, h = _png_size(p)
+    if w * h > MAX_CELLS:  # refused from the header, before Pillow reads (or warns about) it
+        raise ValueError(f"image {w} x {h} has more than {MAX_CELLS} pixels")
     try:
         from PIL import Image  # Pillow: matplotlib's own image dependency
     except ImportError:  # pragma: no cover - Pillow is a dependency
         raise ValueError("reading PNG maps needs Pillow (pip install pillow)") from None
-    with Image.open(p) as opened:
+    with warnings.catch_warnings():
+        # MAX_CELLS is the limit here: Pillow's own (lowered by someone) neither warns nor raises
+        warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+        try:
+            return _read_png(Image.open(p))
+        except Image.DecompressionBombError:  # only with Pillow's limit lowered below 2 x MAX_CELLS
+            raise ValueError(f"image {w} x {h} is beyond Pillow's size limit") from None
+
+
+def _png_size(path: str | Path) -> tuple[int, int]:
+    """(width, height) declared by a PNG file's header (its first chunk, IHDR)."""
+    with Path(path).open("rb") as f:
+        head = f.read(24)
+    if len(head) < 24 or head[:8] != _PNG_MAGIC or head[12:16] != b"IHDR":
+        raise ValueError("bad PNG header (no IHDR chunk after the signature)")
+    w, h = struct.unpack(">II", head[16:24])
+    return int(w), int(h)
+
+
+def _read_png(opened: Any) -> tuple[np.ndarray, np.ndarray | None]:
+    """:func:`read_image` of an opened Pillow image (closed on return)."""
+    from PIL import Image
+
+    with opened:
         im: Image.Image = opened
         if im.width * im.height > MAX_CELLS:
             raise ValueError(f"image {im.width} x {im.height} has more than {MAX_CELLS} pixels")
@@ -257,13 +293,10 @@ def cell_values(shade: np.ndarray, alpha: np.ndarray | None, *, mode: str, negat
 # --------------------------------------------------------------------------------------------
 # The YAML file
 # --------------------------------------------------------------------------------------------
-def _num(src: str, obj: Any, fld: str) -> float:
-    if isinstance(obj, bool) or not isinstance(obj, int | float):
-        raise ScenarioError(src, fld, f"expected a number, got {type(obj).__name__}")
-    x = float(obj)
-    if not math.isfinite(x):
-        raise ScenarioError(src, fld, f"must be finite, got {x}")
-    return x
+def _num(src: str, obj: Any, fld: str, **limits: Any) -> float:
+    """A finite number, checked as the scenario's numbers are (one beyond the float range is
+    refused, not an OverflowError); ``limits`` as :meth:`~anyplan.world.schema.Ctx.number`."""
+    return Ctx(src).number(obj, fld, **limits)
 
 
 def load_map(path: str | Path) -> OccupancyMap:
@@ -299,19 +332,18 @@ def load_map(path: str | Path) -> OccupancyMap:
     image = data["image"]
     if not isinstance(image, str) or not image:
         raise ScenarioError(src, "image", "expected a file name")
-    res = _num(src, data["resolution"], "resolution")
-    if not res > 0.0:
-        raise ScenarioError(src, "resolution", f"must be > 0, got {res:g}")
+    res = _num(src, data["resolution"], "resolution", positive=True, lo=MIN_RESOLUTION_M)
     org = data["origin"]
     if not isinstance(org, list | tuple) or len(org) != 3:
         raise ScenarioError(src, "origin", "expected [x, y, yaw]")
-    ox, oy, yaw = (_num(src, v, f"origin[{i}]") for i, v in enumerate(org))
+    ox, oy = (_num(src, v, f"origin[{i}]", hi=MAX_COORD_M) for i, v in enumerate(org[:2]))
+    yaw = _num(src, org[2], "origin[2]")
     if yaw != 0.0:
         raise ScenarioError(src, "origin[2]", f"yaw {yaw:g} rad is not supported: rotate the "
                                               "image instead (only yaw = 0)")
-    neg = data["negate"]
-    if neg not in (0, 1) or isinstance(neg, float):
-        raise ScenarioError(src, "negate", f"expected 0 or 1, got {neg!r}")
+    neg = data["negate"]  # 0 or 1, or a YAML boolean (Nav2 reads an int, else a bool)
+    if not isinstance(neg, bool) and (not isinstance(neg, int) or neg not in (0, 1)):
+        raise ScenarioError(src, "negate", f"expected 0 or 1 (or true/false), got {shorten(neg)}")
     occ_t = _num(src, data["occupied_thresh"], "occupied_thresh")
     free_t = _num(src, data["free_thresh"], "free_thresh")
     if not 0.0 <= occ_t <= 1.0:
@@ -335,6 +367,12 @@ def load_map(path: str | Path) -> OccupancyMap:
         raise ScenarioError(src, "image", f"{img}: {exc}") from None
     if shade.size == 0:
         raise ScenarioError(src, "image", f"{img}: the image is empty")
+    ny, nx = shade.shape
+    x1, y1 = ox + nx * res, oy + ny * res
+    if not max(abs(x1), abs(y1)) <= MAX_COORD_M:
+        raise ScenarioError(src, "resolution", f"the map's far corner ({x1:g}, {y1:g}) is beyond the "
+                                               f"coordinate limit +-{MAX_COORD_M:g} m (origin + {nx} x "
+                                               f"{ny} cells of {res:g} m)")
     vals = cell_values(shade, alpha, mode=mode, negate=bool(neg), occupied_thresh=occ_t,
                        free_thresh=free_t)[::-1].copy()
     # free: known and value / 100 < free_thresh (trinary, scale: exactly the value-0 cells)
