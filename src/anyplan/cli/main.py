@@ -84,3 +84,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("anyplan: interrupted\n")
         return 130
+
+
+if __name__ == "__main__":  # python -m anyplan.cli.main, as python -m anyplan
+    sys.exit(main())

@@ -22,7 +22,6 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from anyplan.config import SettingError, setting, validate
 from anyplan.prediction.detection import Detection
@@ -228,6 +227,11 @@ class Tracker:
     """
 
     def __init__(self, config: TrackerConfig | None = None) -> None:
+        # scipy.optimize takes about 0.2 s to import: a run that tracks nothing (oracle or
+        # twist perception) never loads it; one that tracks loads it here, before planning
+        from scipy.optimize import linear_sum_assignment
+
+        self._assign = linear_sum_assignment
         self.config = config or TrackerConfig()
         self.names: list[str] = []
         self.x = np.zeros((0, 2, 5))
@@ -419,7 +423,7 @@ class Tracker:
             # assignment first has as few of them as it can, then the least cost
             lo = float(sub[sub_ok].min())
             big = 1.0 + float((sub[sub_ok] - lo).sum()) * 2.0 + 1e6
-            r, c = linear_sum_assignment(np.where(sub_ok, sub - lo, big))
+            r, c = self._assign(np.where(sub_ok, sub - lo, big))
             for a, b in zip(r, c, strict=True):
                 if sub_ok[a, b]:
                     pairs.append((int(cols[b]), int(cand[rows[a]])))
