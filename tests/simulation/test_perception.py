@@ -279,7 +279,7 @@ def test_a_bad_tracker_setting_names_the_field():
 
     with pytest.raises(SettingError, match=r"SimConfig\.tracker: unknown tracker setting 'ksigma'"):
         SimConfig(tracker=(("ksigma", 1.0),))
-    with pytest.raises(SettingError, match=r"UncertaintyModel\.cap_m: must be >= 0"):
+    with pytest.raises(SettingError, match=r"UncertaintyModel\.cap_m: must be in \[0, 100\] m"):
         SimConfig(tracker=(("cap_m", -1.0),))
 
 
