@@ -19,15 +19,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         "motions), with 'sensing: {mode: tracked}'. See anyplan.experiments.crowds.")
     p.add_argument("file", help="obsmat file (frame person x z y vx vz vy per row)")
     p.add_argument("--out", required=True, help="output folder")
-    p.add_argument("--name", default=None, help="scenario name prefix (default: from the file name)")
+    p.add_argument("--name", default=None, help="scenario name prefix, a plain file-name stem "
+                   "(letters, digits, ._+-; default: from the file name)")
     p.add_argument("--window", type=float, default=d.window_s,
                    help=f"window length [s] (default {d.window_s:g})")
     p.add_argument("--step", type=float, default=d.step_s,
-                   help=f"window start spacing [s] (default {d.step_s:g})")
+                   help=f"window start spacing [s] (default {d.step_s:g}; at most 1000 windows)")
     p.add_argument("--copies", type=int, default=d.copies,
-                   help="overlay this many time-shifted copies of the recording (denser crowds; default 1)")
+                   help="overlay this many time-shifted copies of the recording (denser crowds; 1-100; "
+                        "default 1)")
     p.add_argument("--copy-shift", type=float, default=d.copy_shift_s,
-                   help=f"time shift [s] between copies (default {d.copy_shift_s:g})")
+                   help=f"time shift [s] between copies, > 0 (default {d.copy_shift_s:g})")
     p.add_argument("--margin", type=float, default=d.margin_m,
                    help=f"arena margin around the recorded positions [m] (default {d.margin_m:g})")
     p.add_argument("--edge", type=float, default=d.edge_m,

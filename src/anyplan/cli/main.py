@@ -29,7 +29,9 @@ FLAGS = {"runs": "--runs", "jobs": "--jobs", "planners": "--planners", "config":
          "ompl": "--ompl", "mcap": "--mcap", "source": "--source", "worlds_file": "--worlds-file",
          "worlds": "--worlds", "window_s": "--window", "step_s": "--step", "margin_m": "--margin",
          "edge_m": "--edge", "sensing_range_m": "--sensing-range", "noise_m": "--sensor-noise",
-         "rate_hz": "--sensor-rate", "copies": "--copies", "copy_shift_s": "--copy-shift"}
+         "rate_hz": "--sensor-rate", "copies": "--copies", "copy_shift_s": "--copy-shift",
+         "name": "--name", **{f"robot_{k}": f"--robot-{k.replace('_', '-')}" for k in (
+             "radius", "v_max", "omega_max", "a_max", "alpha_max", "goal_tolerance")}}
 
 #: Modules that each register one or more sub-commands.
 COMMAND_MODULES = [

@@ -14,12 +14,13 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from anyplan.errors import AnyplanError
+from anyplan.errors import AnyplanError, ScenarioError
 from anyplan.experiments import dynabarn
 from anyplan.world.scenario import Scenario, scenario_from_dict
 from anyplan.world.yaml_load import dump_yaml
@@ -60,21 +61,17 @@ def default_source(cwd: str | Path | None = None) -> Path:
 
 
 def _num(obj: Any, where: str, positive: bool = False) -> float:
-    if isinstance(obj, bool) or not isinstance(obj, int | float) or not math.isfinite(obj):
-        raise BARNError(f"{where}: expected a finite number, got {obj!r}")
-    if positive and obj <= 0:
-        raise BARNError(f"{where}: expected a positive number, got {obj!r}")
-    return float(obj)
+    return dynabarn.finite(obj, where, BARNError, positive)
+
+
+#: Keys of a world in ``worlds.json``.
+_WORLD_KEYS = ("world", "cylinders", "reference_path_length_m")
 
 
 def _check_world(w: Any, k: int, src: str) -> None:
-    where = f"{src}: [{k}]"
-    if not isinstance(w, Mapping):
-        raise BARNError(f"{where}: expected a world object")
-    idx = w.get("world")
-    if isinstance(idx, bool) or not isinstance(idx, int):
-        raise BARNError(f"{where}.world: expected an integer index, got {idx!r}")
+    idx = dynabarn.world_index(w, k, src, BARNError)
     where = f"{src}: world {idx}"
+    dynabarn.check_keys(w, _WORLD_KEYS, where, BARNError)
     _num(w.get("reference_path_length_m"), f"{where}.reference_path_length_m", positive=True)
     cyl = w.get("cylinders")
     if not isinstance(cyl, list) or not cyl:
@@ -108,12 +105,12 @@ def load_worlds(path: str | Path) -> list[dict[str, Any]]:
         raise BARNError(f"{p}: not a readable JSON file ({type(exc).__name__})") from None
     if not isinstance(data, list) or not data:
         raise BARNError(f"{p}: expected a non-empty JSON list of worlds")
-    seen = set()
+    seen: dict[int, int] = {}
     for k, w in enumerate(data):
         _check_world(w, k, str(p))
         if w["world"] in seen:
-            raise BARNError(f"{p}: world {w['world']} appears twice")
-        seen.add(w["world"])
+            raise BARNError(f"{p}: world {w['world']} appears twice ([{seen[w['world']]}] and [{k}])")
+        seen[w["world"]] = k
     return data
 
 
@@ -127,12 +124,13 @@ def parse_worlds(spec: str, n_worlds: int = N_WORLDS) -> list[int]:
 
 
 def world_to_scenario(world: Mapping[str, Any], profile: Mapping[str, float] | None = None,
-                      name: str | None = None) -> dict[str, Any]:
+                      name: str | None = None, source: str | Path | None = None) -> dict[str, Any]:
     """The scenario dictionary (our YAML schema) of one BARN world (validated by
     :func:`load_worlds`).
 
     Raises:
-        BARNError: the world does not make a valid scenario (e.g. a cylinder on the start).
+        BARNError: the world does not make a valid scenario (e.g. a cylinder on the start),
+            naming the file (``source``), the world and the cylinder.
     """
     prof = dict(JACKAL if profile is None else profile)
     idx = int(world["world"])
@@ -151,11 +149,27 @@ def world_to_scenario(world: Mapping[str, Any], profile: Mapping[str, float] | N
                   "goal": [GOAL[0] + SHIFT[0], GOAL[1] + SHIFT[1]], **prof},
         "static_obstacles": statics,
     }
+    where = (f"{source}: " if source is not None else "") + f"world {idx}"
     try:
         scenario_from_dict(data, f"<barn world {idx}>")  # validate (start/goal free, schema)
     except AnyplanError as exc:
-        raise BARNError(f"world {idx}: does not convert to a valid scenario: {exc}") from None
+        raise _converted_error(exc, where, world, float(prof["radius"])) from None
     return data
+
+
+def _converted_error(exc: AnyplanError, where: str, world: Mapping[str, Any],
+                     radius: float) -> AnyplanError:
+    """A scenario error told in the worlds file's terms: a cylinder on the start or goal as
+    ``world N.cylinders[K]``, in BARN's frame."""
+    m = re.search(r"inside static obstacle c(\d+) ", exc.message) if isinstance(exc, ScenarioError) \
+        else None
+    if m and isinstance(exc, ScenarioError) and exc.field in ("robot.start", "robot.goal"):
+        k = int(m.group(1))
+        x, y, r = (float(v) for v in world["cylinders"][k])
+        which, (px, py) = ("start", START[:2]) if exc.field == "robot.start" else ("goal", GOAL)
+        return BARNError(f"{where}.cylinders[{k}]: ({x:g}, {y:g}) r {r:g} is within the robot "
+                         f"radius {radius:g} of the challenge's {which} ({px:g}, {py:g})")
+    return dynabarn.converted_error(exc, where, {"static_obstacles": "cylinders"}, BARNError)
 
 
 @dataclass(frozen=True)
@@ -213,6 +227,11 @@ def convert(source: str | Path, out_dir: str | Path, worlds: Sequence[int] | str
         idx = sorted(by_index)
     else:
         idx = parse_worlds(worlds, n_worlds=n) if isinstance(worlds, str) else list(worlds)
+    for i in idx:
+        if i not in by_index:
+            raise BARNError(f"world {i} is not in {source}")
+    # Every selected world converts before anything is written.
+    scenarios = [(i, world_to_scenario(by_index[i], profile, source=source)) for i in idx]
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     index_path = out / INDEX_FILE
@@ -223,10 +242,7 @@ def convert(source: str | Path, out_dir: str | Path, worlds: Sequence[int] | str
         except (json.JSONDecodeError, AttributeError, TypeError, ValueError):
             index = {}
     paths = []
-    for i in idx:
-        if i not in by_index:
-            raise BARNError(f"world {i} is not in {source}")
-        sc = world_to_scenario(by_index[i], profile)
+    for i, sc in scenarios:
         p = out / f"{sc['name']}.yaml"
         ref = float(by_index[i]["reference_path_length_m"])
         header = ("# Converted by 'anyplan import-barn' from BARN (Perille et al., SSRR 2020), BARN\n"

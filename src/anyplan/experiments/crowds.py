@@ -14,6 +14,7 @@ crowds: conventions".
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,12 +22,14 @@ from typing import Any
 
 import numpy as np
 
-from anyplan.errors import AnyplanError
+from anyplan.errors import AnyplanError, ScenarioError, one_line, shorten
+from anyplan.world import limits as L
 from anyplan.world.scenario import scenario_from_dict
 from anyplan.world.yaml_load import dump_yaml
 
 __all__ = ["CrowdError", "CrowdOptions", "SERVICE_ROBOT", "PERSON_RADIUS", "FRAME_RATE",
-           "read_obsmat", "crowd_scenarios", "import_crowd"]
+           "MAX_FRAME", "MAX_PERSON_ID", "MAX_NAME_CHARS", "read_obsmat", "crowd_scenarios",
+           "import_crowd"]
 
 #: Small service robot: radius [m], v [m/s], omega [rad/s], a [m/s^2], alpha [rad/s^2].
 SERVICE_ROBOT: dict[str, float] = {"radius": 0.3, "v_max": 1.0, "omega_max": 1.5, "a_max": 1.0,
@@ -35,6 +38,17 @@ SERVICE_ROBOT: dict[str, float] = {"radius": 0.3, "v_max": 1.0, "omega_max": 1.5
 PERSON_RADIUS = 0.25
 #: Video frames per second of ETH and UCY.
 FRAME_RATE = 25.0
+#: Largest frame number: the event-time limit (10^6 s) at 25 frames/s.
+MAX_FRAME = FRAME_RATE * L.MAX_EVENT_TIME_S
+#: Largest absolute person id (ids are exact in a float).
+MAX_PERSON_ID = 10**9
+#: Longest ``name`` (the prefix of the scenario names and files) [characters].
+MAX_NAME_CHARS = 100
+#: Limits of the robot options (``robot`` keys of :class:`CrowdOptions`), as the scenario's.
+_ROBOT_RANGES: dict[str, tuple[float, float]] = {"radius": L.ROBOT_RADIUS_M, **L.ROBOT_LIMITS,
+                                                 "goal_tolerance": (0.0, L.MAX_ARENA_M)}
+#: The columns of an obsmat row.
+_COLUMNS = ("frame", "person", "x", "z", "y", "vx", "vz", "vy")
 
 
 class CrowdError(AnyplanError):
@@ -57,20 +71,42 @@ class CrowdOptions:
     robot: Mapping[str, float] | None = None
 
     def check(self) -> None:
-        """Raises CrowdError on an out-of-range option."""
-        for name in ("window_s", "step_s", "margin_m", "edge_m", "sensing_range_m", "rate_hz"):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and v > 0.0):
-                raise CrowdError.about(name, f" must be > 0, got {v:g}")
-        if not (math.isfinite(self.noise_m) and self.noise_m >= 0.0):
-            raise CrowdError.about("noise_m", f" must be >= 0 m, got {self.noise_m:g}")
-        if self.copies < 1:
-            raise CrowdError.about("copies", f" must be >= 1, got {self.copies}")
+        """Raises CrowdError on an out-of-range option (each checked against its stated limit)."""
+        for name, hi in (("window_s", L.MAX_TIME_LIMIT_S), ("step_s", math.inf),
+                         ("copy_shift_s", L.MAX_EVENT_TIME_S), ("margin_m", L.MAX_ARENA_M),
+                         ("edge_m", L.MAX_ARENA_M), ("sensing_range_m", L.MAX_COORD_M),
+                         ("rate_hz", L.MAX_SENSOR_RATE_HZ)):
+            _check_range(name, getattr(self, name), 0.0, hi)
+        _check_range("noise_m", self.noise_m, 0.0, L.MAX_SIZE_M, zero=True)
+        if isinstance(self.copies, bool) or not isinstance(self.copies, int) \
+                or not 1 <= self.copies <= L.MAX_CROWD_COPIES:
+            raise CrowdError.about("copies", f" must be an integer in [1, {L.MAX_CROWD_COPIES}] "
+                                   f"(the stated limit), got {shorten(self.copies)}")
         if self.edge_m >= self.margin_m:
             raise CrowdError.about("edge_m", " must be smaller than {margin_m}", "margin_m")
         for k, v in (self.robot or {}).items():
-            if not (math.isfinite(v) and v > 0.0):
-                raise CrowdError(f"import-crowd: robot {k} must be > 0, got {v:g}")
+            if k not in _ROBOT_RANGES:
+                raise CrowdError(f"import-crowd: robot: unknown key {shorten(k)} "
+                                 f"(known: {', '.join(_ROBOT_RANGES)})")
+            lo, hi = _ROBOT_RANGES[k]
+            _check_range(f"robot_{k}", v, 0.0, hi, lo=lo)
+        r = float({**SERVICE_ROBOT, **(self.robot or {})}["radius"])
+        if self.edge_m < r:
+            raise CrowdError.about("edge_m", f" must be >= the robot's radius ({{robot_radius}} "
+                                   f"{r:g} m), got {self.edge_m:g}", "robot_radius")
+
+
+def _check_range(name: str, v: Any, floor: float, hi: float, lo: float = 0.0,
+                 zero: bool = False) -> None:
+    """Option ``name`` is a finite number > ``floor`` (>= with ``zero``), >= ``lo`` and <= ``hi``."""
+    ok = isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+    shown = f"{v:g}" if isinstance(v, int | float) and not isinstance(v, bool) else shorten(v)
+    if not ok or (v < floor if zero else v <= floor):
+        rel = ">=" if zero else ">"
+        raise CrowdError.about(name, f" must be a finite number {rel} {floor:g}, got {shown}")
+    if v < lo or v > hi:
+        bounds = f"[{lo:g}, {hi:g}]" if zero or lo > floor else f"({lo:g}, {hi:g}]"
+        raise CrowdError.about(name, f" must be in {bounds} (the stated limit), got {shown}")
 
 
 def read_obsmat(path: str | Path) -> dict[int, np.ndarray]:
@@ -96,12 +132,7 @@ def read_obsmat(path: str | Path) -> dict[int, np.ndarray]:
         except ValueError:
             raise CrowdError(f"{p}: line {i}: expected 8 numbers (frame person x z y vx vz vy), "
                              f"got '{line.strip()[:40]}'") from None
-        if len(vals) != 8 or not all(math.isfinite(v) for v in vals):
-            raise CrowdError(f"{p}: line {i}: expected 8 finite numbers (frame person x z y vx vz "
-                             f"vy), got {len(vals)}")
-        if vals[1] != int(vals[1]):
-            raise CrowdError(f"{p}: line {i}: person id must be an integer, got {vals[1]:g}")
-        rows.append((vals[0], int(vals[1]), vals[2], vals[4]))
+        rows.append(_check_row(vals, f"{p}: line {i}"))
     if not rows:
         raise CrowdError(f"{p}: no rows")
     f0 = min(r[0] for r in rows)
@@ -115,6 +146,30 @@ def read_obsmat(path: str | Path) -> dict[int, np.ndarray]:
             raise CrowdError(f"{p}: person {pid}: the same frame appears twice")
         out[pid] = a
     return out
+
+
+def _check_row(vals: list[float], where: str) -> tuple[float, int, float, float]:
+    """(frame, person, x, y) of one obsmat row, each within its stated limit."""
+    if len(vals) != 8:
+        raise CrowdError(f"{where}: expected 8 finite numbers (frame person x z y vx vz vy), "
+                         f"got {len(vals)}")
+    for col, v in zip(_COLUMNS, vals, strict=True):
+        if not math.isfinite(v):
+            raise CrowdError(f"{where}: {col}: expected a finite number, got {v}")
+    frame, pid, x, y = vals[0], vals[1], vals[2], vals[4]
+    if not 0.0 <= frame <= MAX_FRAME:
+        raise CrowdError(f"{where}: frame: must be in [0, {MAX_FRAME:g}] (10^6 s at {FRAME_RATE:g} "
+                         f"frames/s, the stated limit), got {frame:g}")
+    if pid != int(pid):
+        raise CrowdError(f"{where}: person id must be an integer, got {pid:g}")
+    if abs(pid) > MAX_PERSON_ID:
+        raise CrowdError(f"{where}: person: id must be within +-{MAX_PERSON_ID:g} (the stated "
+                         f"limit), got {pid:g}")
+    for col, v in (("x", x), ("y", y)):
+        if abs(v) > L.MAX_COORD_M:
+            raise CrowdError(f"{where}: {col}: must be within +-{L.MAX_COORD_M:g} m (the stated "
+                             f"limit), got {v:g}")
+    return frame, int(pid), x, y
 
 
 def _copy(tracks: Mapping[int, np.ndarray], k: int, shift: float,
@@ -166,29 +221,47 @@ def _occupancy(people: list[tuple[str, np.ndarray]], p: np.ndarray, reach: float
 
 
 def crowd_scenarios(tracks: Mapping[int, np.ndarray], name: str,
-                    options: CrowdOptions | None = None) -> list[dict[str, Any]]:
-    """Scenario dictionaries (our YAML schema), one per usable window of the recording."""
+                    options: CrowdOptions | None = None, source: str | None = None
+                    ) -> list[dict[str, Any]]:
+    """Scenario dictionaries (our YAML schema), one per usable window of the recording.
+
+    Raises:
+        CrowdError: a bad option, or a recording or window beyond a stated limit, naming
+            ``source`` (the obsmat file; default ``name``).
+    """
     opt = options or CrowdOptions()
     opt.check()
+    src = source or name
     robot = {**SERVICE_ROBOT, **(opt.robot or {})}
     r = robot["radius"]
+    if not tracks:
+        raise CrowdError(f"{src}: no people")
     allp = np.vstack(list(tracks.values()))
+    _check_arena(tracks, allp, opt.margin_m, src)
     xmin, ymin = allp[:, 1].min(), allp[:, 2].min()
     sx, sy = opt.margin_m - xmin, opt.margin_m - ymin
     width = float(allp[:, 1].max() - xmin + 2 * opt.margin_m)
     height = float(allp[:, 2].max() - ymin + 2 * opt.margin_m)
+    t_end = float(max(tr[-1, 0] for tr in tracks.values()))
+    period = t_end + 0.4  # one annotation interval after the last frame: no two copies' samples meet
+    n_win = _count_windows(t_end, opt, src)
+    _check_shift(opt, period, src)
     shifted = {pid: np.column_stack([tr[:, 0], tr[:, 1] + sx, tr[:, 2] + sy])
                for pid, tr in tracks.items()}
-    t_end = float(max(tr[-1, 0] for tr in tracks.values()))
     along_x = width >= height
     long_side, short_side = (width, height) if along_x else (height, width)
     out = []
-    period = t_end + 0.4  # one annotation interval after the last frame: no two copies' samples meet
     copies = [_copy(shifted, k, opt.copy_shift_s, period) for k in range(opt.copies)]
-    n_win = int(math.floor((t_end - opt.window_s) / opt.step_s + 1e-9)) + 1
-    for w in range(max(n_win, 0)):
+    for w in range(n_win):
         t0 = w * opt.step_s
+        span = f"window {w} ({t0:g}-{t0 + opt.window_s:g} s after the first frame)"
         people = _window_people(copies, t0, opt.window_s)
+        if len(people) > L.MAX_MOVING_OBSTACLES:
+            copies_, fewer = (f" ({opt.copies} copies)", "fewer {copies} or ") if opt.copies > 1 else ("", "")
+            raise CrowdError.about(
+                src, f": {span} holds {len(people)} people{copies_}, more than the "
+                f"{L.MAX_MOVING_OBSTACLES} moving obstacles of a scenario (the stated limit); use "
+                + fewer + "a shorter {window_s}", "copies", "window_s")
         grid = np.arange(0.0, opt.window_s + 1e-9, 0.1)
         chosen = None
         for off in [0.0] + [s * k for k in range(1, int(short_side / 2)) for s in (1.0, -1.0)]:
@@ -229,25 +302,93 @@ def crowd_scenarios(tracks: Mapping[int, np.ndarray], name: str,
         }
         try:
             scenario_from_dict(data, f"<{data['name']}>")
+        except ScenarioError as exc:
+            raise CrowdError(f"{src}: {span}: {_who(exc.field, people)}{exc.message}") from None
         except AnyplanError as exc:
-            raise CrowdError(f"{name}: window {w} does not convert to a valid scenario: {exc}") from None
+            raise CrowdError(f"{src}: {span} does not convert to a valid scenario: {exc}") from None
         out.append(data)
     return out
+
+
+def _check_arena(tracks: Mapping[int, np.ndarray], allp: np.ndarray, margin: float, src: str) -> None:
+    """The arena (the positions' bounding box grown by ``margin``) fits the stated limit."""
+    for axis, col in (("x", 1), ("y", 2)):
+        lo, hi = float(allp[:, col].min()), float(allp[:, col].max())
+        if hi - lo + 2 * margin <= L.MAX_ARENA_M:
+            continue
+        who = [next(pid for pid, tr in tracks.items() if np.any(tr[:, col] == v)) for v in (lo, hi)]
+        raise CrowdError.about(
+            src, f": {axis} spans {lo:g} (person {who[0]}) to {hi:g} m (person {who[1]}); with "
+            f"{{margin_m}} {margin:g} m the arena would be {hi - lo + 2 * margin:g} m, more than "
+            f"the stated limit {L.MAX_ARENA_M:g} m", "margin_m")
+
+
+def _count_windows(t_end: float, opt: CrowdOptions, src: str) -> int:
+    """The number of windows, refused beyond the stated limit before any is made."""
+    q = (t_end - opt.window_s) / opt.step_s  # may be huge (a tiny step) or inf, never NaN
+    if q < 0.0:
+        return 0
+    if q < 2 * L.MAX_IMPORT_SCENARIOS:
+        n = int(math.floor(q + 1e-9)) + 1
+        if n <= L.MAX_IMPORT_SCENARIOS:
+            return n
+        many = str(n)
+    else:
+        many = f"about {q + 1.0:.3g}" if math.isfinite(q) else "countless"
+    raise CrowdError.about(
+        src, f": windows of {opt.window_s:g} s ({{window_s}}) every {opt.step_s:g} s ({{step_s}}) "
+        f"over the recording's {t_end:g} s make {many} scenarios, more than the stated limit "
+        f"{L.MAX_IMPORT_SCENARIOS} per import", "window_s", "step_s")
+
+
+def _check_shift(opt: CrowdOptions, period: float, src: str) -> None:
+    """No copy replays the recording at the times of the first (a shift = a multiple of T)."""
+    for k in range(1, opt.copies):
+        rem = math.fmod(k * opt.copy_shift_s, period)
+        if min(rem, period - rem) < 1e-6:
+            raise CrowdError.about(
+                src, f": copies 0 and {k} would coincide: {k} x {{copy_shift_s}} {opt.copy_shift_s:g}"
+                f" s is a multiple of the recording's length {period:g} s (the shift is cyclic)",
+                "copy_shift_s")
+
+
+def _who(fld: str, people: list[tuple[str, np.ndarray]]) -> str:
+    """The person (and copy) a converted scenario's field is about, for a message."""
+    m = re.match(r"dynamic_obstacles\[(\d+)\]", fld)
+    who = re.fullmatch(r"P(-?\d+)(?:c(\d+)b?)?", people[int(m.group(1))][0]) \
+        if m and int(m.group(1)) < len(people) else None
+    if who is None:
+        return f"{fld}: "
+    return f"person {who.group(1)}" + (f" (copy {who.group(2)})" if who.group(2) else "") + ": "
 
 
 def import_crowd(path: str | Path, out_dir: str | Path, options: CrowdOptions | None = None,
                  name: str | None = None) -> list[Path]:
     """Write one scenario YAML file per window of the obsmat file ``path``; returns the paths."""
     p = Path(path)
+    if name is not None:
+        _check_name(name)
+    opt = options or CrowdOptions()
+    opt.check()
     tracks = read_obsmat(p)
     base = name or p.stem.replace("_obsmat", "").replace("_", "-")
-    scenarios = crowd_scenarios(tracks, base, options)
+    scenarios = crowd_scenarios(tracks, base, opt, source=str(p))
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = []
     for sc in scenarios:
         f = out / f"{sc['name']}.yaml"
-        f.write_text(f"# Converted by 'anyplan import-crowd' from {p.name} (ETH/UCY obsmat).\n"
+        f.write_text(f"# Converted by 'anyplan import-crowd' from {one_line(p.name, 200)} (ETH/UCY "
+                     "obsmat).\n"
                      + dump_yaml(sc, sort_keys=False, default_flow_style=None, width=100))
         paths.append(f)
     return paths
+
+
+def _check_name(name: str) -> None:
+    """``name`` is a plain file-name stem: the files it names stay in the output folder."""
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_+-][A-Za-z0-9._+-]*", name) \
+            or len(name) > MAX_NAME_CHARS:
+        raise CrowdError.about("name", f" {shorten(name)}: expected a plain file-name stem (letters, "
+                               f"digits and ._+-, not starting with a dot, at most {MAX_NAME_CHARS} "
+                               "characters; no path separators)")

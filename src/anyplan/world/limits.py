@@ -13,6 +13,7 @@ __all__ = [
     "MAX_OBSTACLE_TURN_RATE", "MAX_ANGLE_RAD", "MAX_TIME_LIMIT_S", "MAX_EVENT_TIME_S",
     "MAX_STATIC_OBSTACLES", "MAX_MOVING_OBSTACLES", "MAX_POLYGON_POINTS", "MAX_KEYFRAMES",
     "MIN_DT_S", "MAX_SIM_STEPS", "MAX_SEED", "MAX_TEXT_CHARS", "MAX_SENSOR_RATE_HZ",
+    "MAX_IMPORT_SCENARIOS", "MAX_CROWD_COPIES",
 ]
 
 #: Largest arena side [m].
@@ -56,3 +57,8 @@ MAX_SEED = 2**63 - 1
 MAX_SENSOR_RATE_HZ = 1000.0
 #: Longest name or description [characters].
 MAX_TEXT_CHARS = 2000
+#: Most scenario files one import (``import-crowd`` windows, ``import-barn``/``import-dynabarn``
+#: worlds) writes; world indices are in [0, MAX_IMPORT_SCENARIOS - 1].
+MAX_IMPORT_SCENARIOS = 1000
+#: Most overlaid copies of a recorded crowd (``import-crowd --copies``).
+MAX_CROWD_COPIES = 100
