@@ -37,6 +37,7 @@ from anyplan.viz.style import (
     tight,
 )
 from anyplan.world.scenario import Scenario, scenario_from_dict
+from anyplan.world.sensing import without_unread_settings
 
 __all__ = ["build_report", "figure4", "boxplots", "cost_time_figure", "draw_run_panel"]
 
@@ -60,7 +61,10 @@ def _scenarios(db: ResultsDB) -> dict[int, Scenario]:
     out = {}
     for e in db.experiments():
         try:
-            out[int(e["id"])] = scenario_from_dict(json.loads(e["setup"]), f"<db experiment {e['id']}>")
+            data = json.loads(e["setup"])
+            if isinstance(data, dict) and "sensing" in data:  # stored before oracle and twist
+                data["sensing"] = without_unread_settings(data["sensing"])  # refused tracked keys
+            out[int(e["id"])] = scenario_from_dict(data, f"<db experiment {e['id']}>")
         except (TypeError, ValueError, KeyError):
             continue  # an imported OMPL experiment: its setup is not a scenario
     return out

@@ -164,6 +164,8 @@ class Scenario:
             d = self.to_dict()
             if self.static_map is not None:
                 d["static_map"] = self.static_map.digest()  # the content, not where it lives
+            if self.sensing is not None:  # every setting, as hashed before (SensingSpec.identity)
+                d["sensing"] = self.sensing.identity()
             blob = json.dumps(d, sort_keys=True, default=float).encode()
             cached = cache["content_hash"] = hashlib.sha256(blob).hexdigest()[:16]
         return str(cached)
@@ -243,10 +245,8 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
 
     rob = c.mapping(top["robot"], "robot")
     c.keys(rob, "robot", _ROBOT_REQUIRED, _ROBOT_OPTIONAL)
-    start = c.vector(rob["start"], "robot.start", 3)
+    start = c.pose(rob["start"], "robot.start")
     goal = c.vector(rob["goal"], "robot.goal", 2)
-    if abs(start[2]) > L.MAX_ANGLE_RAD:
-        c.number(start[2], "robot.start[2]", hi=L.MAX_ANGLE_RAD)
     ranges = {"radius": L.ROBOT_RADIUS_M, **L.ROBOT_LIMITS}
     vals = {k: c.number(rob[k], f"robot.{k}", positive=True, lo=lo, hi=hi)
             for k, (lo, hi) in ranges.items()}
@@ -269,10 +269,13 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     moving_raw = c.items(top.get(mkey), mkey, L.MAX_MOVING_OBSTACLES)
     moving = tuple(parse_moving(c, o, f"{mkey}[{i}]", i)
                    for i, o in enumerate(moving_raw))
-    names = [o.name for o in statics] + [o.name for o in moving]
-    for i, n in enumerate(names):
-        if n in names[:i]:
-            raise c.fail("name", f"obstacle name '{n}' is used twice")
+    first: dict[str, str] = {}  # an obstacle's name -> the field of the first obstacle with it
+    named = [(o.name, f"static_obstacles[{i}]") for i, o in enumerate(statics)] + \
+        [(o.name, f"{mkey}[{i}]") for i, o in enumerate(moving)]
+    for n, fld in named:
+        if n in first:
+            raise c.fail(f"{fld}.name", f"obstacle name '{n}' is used twice (also by {first[n]})")
+        first[n] = fld
 
     sc = Scenario(name=name, width=width, height=height, robot=robot, static_obstacles=statics,
                   moving_obstacles=moving, description=description, time_limit=time_limit,
@@ -331,9 +334,11 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
 
     Raises:
         ScenarioError: the file is unreadable, not YAML or does not follow the schema.
-        UnknownNameError: neither a built-in name nor an existing file.
+        UnknownNameError: neither a built-in name nor an existing file (or an empty name).
     """
     s = str(name_or_path)
+    if not s.strip():  # Path("") is the current folder: not a scenario the user named
+        raise UnknownNameError("scenario", s, list(builtin_scenarios()))
     path = Path(s)
     try:
         exists = path.exists()

@@ -24,7 +24,7 @@ from anyplan.geometry.shapes import Circle, Polygon, Shape, rectangle
 from anyplan.registry import Registry
 from anyplan.world import limits as L
 from anyplan.world.motion import Motion, TrackMotion, UnicycleMotion, WaypointMotion
-from anyplan.world.sensing import MAX_CLUTTER_RATE, SensingError, SensingSpec
+from anyplan.world.sensing import MAX_CLUTTER_RATE, MODES, TRACKED_ONLY, SensingError, SensingSpec
 
 __all__ = ["StaticObstacle", "MovingObstacle", "Ctx", "OBSTACLE_TYPES", "MOTION_TYPES",
            "parse_static", "parse_moving", "parse_sensing", "join_field", "typename"]
@@ -111,6 +111,14 @@ class Ctx:
             raise self.fail(fld, f"expected a list of {n} numbers, got {_short(obj)}")
         return tuple(self.number(v, f"{fld}[{i}]", hi=hi) for i, v in enumerate(obj))
 
+    def pose(self, obj: Any, fld: str) -> tuple[float, float, float]:
+        """A pose ``[x, y, theta]``: coordinates within the coordinate limit, the heading within
+        the angle limit."""
+        if not isinstance(obj, list | tuple) or len(obj) != 3:
+            raise self.fail(fld, f"expected a list of 3 numbers, got {_short(obj)}")
+        x, y = (self.number(v, f"{fld}[{i}]", hi=L.MAX_COORD_M) for i, v in enumerate(obj[:2]))
+        return x, y, self.number(obj[2], f"{fld}[2]", hi=L.MAX_ANGLE_RAD)
+
     def string(self, obj: Any, fld: str) -> str:
         if not isinstance(obj, str) or not obj:
             raise self.fail(fld, f"expected a non-empty string, got {typename(obj)}")
@@ -177,9 +185,7 @@ def _polygon(c: Ctx, m: Mapping[str, Any], fld: str) -> Shape:
 
 def _unicycle(c: Ctx, m: Mapping[str, Any], fld: str) -> Motion:
     c.keys(m, fld, ("start", "v", "radius"), ("name", "type", "omega", "start_time"))
-    x0, y0, th0 = c.vector(m["start"], join_field(fld, "start"), 3)
-    if abs(th0) > L.MAX_ANGLE_RAD:
-        c.number(th0, f"{join_field(fld, 'start')}[2]", hi=L.MAX_ANGLE_RAD)
+    x0, y0, th0 = c.pose(m["start"], join_field(fld, "start"))
     v = c.number(m["v"], join_field(fld, "v"), hi=L.MAX_OBSTACLE_SPEED)
     omega = c.number(m.get("omega", 0.0), join_field(fld, "omega"), hi=L.MAX_OBSTACLE_TURN_RATE)
     t0 = c.number(m.get("start_time", 0.0), join_field(fld, "start_time"), nonneg=True,
@@ -201,17 +207,24 @@ def _timed_rows(c: Ctx, m: Mapping[str, Any], fld: str, key: str) -> list[tuple[
     return rows
 
 
-def _waypoints(c: Ctx, m: Mapping[str, Any], fld: str) -> Motion:
-    rows = _timed_rows(c, m, fld, "keyframes")
+def _timed_motion(c: Ctx, m: Mapping[str, Any], fld: str, key: str,
+                  kind: type[WaypointMotion] | type[TrackMotion]) -> Motion:
+    """A ``waypoints`` (``keyframes``) or ``track`` (``samples``) motion whose segments are no
+    faster than the moving obstacles' speed limit."""
+    rows = _timed_rows(c, m, fld, key)
     try:
-        motion = WaypointMotion(np.array(rows))
+        motion = kind(np.array(rows))
         speed = motion.max_speed
     except (ValueError, FloatingPointError) as exc:
-        raise c.fail(join_field(fld, "keyframes"), str(exc)) from None
+        raise c.fail(join_field(fld, key), str(exc)) from None
     if not speed <= L.MAX_OBSTACLE_SPEED:
-        raise c.fail(join_field(fld, "keyframes"), f"a segment is faster than "
-                     f"{L.MAX_OBSTACLE_SPEED:g} m/s (the stated limit)")
+        raise c.fail(join_field(fld, key), f"a segment is faster than {L.MAX_OBSTACLE_SPEED:g} m/s "
+                     f"(the stated limit), got {speed:.6g} m/s")
     return motion
+
+
+def _waypoints(c: Ctx, m: Mapping[str, Any], fld: str) -> Motion:
+    return _timed_motion(c, m, fld, "keyframes", WaypointMotion)
 
 
 #: Static obstacle types of the schema (``type:``): name -> parser ``(ctx, mapping, field)``.
@@ -271,11 +284,7 @@ def _check_rows(c: Ctx, rows: list[tuple[float, ...]], fld: str) -> None:
 
 
 def _parse_track(c: Ctx, m: Mapping[str, Any], fld: str) -> Motion:
-    rows = _timed_rows(c, m, fld, "samples")
-    try:
-        return TrackMotion(np.array(rows))
-    except ValueError as exc:
-        raise c.fail(join_field(fld, "samples"), str(exc)) from None
+    return _timed_motion(c, m, fld, "samples", TrackMotion)
 
 
 MOTION_TYPES.register("unicycle", _unicycle)
@@ -289,6 +298,11 @@ def parse_sensing(c: Ctx, obj: Any) -> SensingSpec:
     c.keys(m, "sensing", ("mode",), ("noise_m", "rate_hz", "association", "detection_prob",
                                      "clutter_rate", "occlusion"))
     mode = c.string(m["mode"], "sensing.mode")
+    if mode in MODES and mode != "tracked":
+        for key in TRACKED_ONLY:
+            if key in m:
+                raise c.fail(f"sensing.{key}", f"only mode: tracked reads it, and this block's "
+                                               f"mode is '{mode}' (remove the key, or set mode: tracked)")
     noise = c.number(m.get("noise_m", SensingSpec.noise_m), "sensing.noise_m", nonneg=True,
                      hi=L.MAX_SIZE_M)
     rate = c.number(m.get("rate_hz", SensingSpec.rate_hz), "sensing.rate_hz", positive=True,

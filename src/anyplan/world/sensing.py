@@ -20,11 +20,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from anyplan.errors import AnyplanError
 
-__all__ = ["MODES", "ASSOCIATIONS", "OCCLUSIONS", "SensingSpec", "SensingError", "DEFAULT_NOISE_M",
-           "DEFAULT_RATE_HZ", "MAX_CLUTTER_RATE"]
+__all__ = ["MODES", "ASSOCIATIONS", "OCCLUSIONS", "TRACKED_ONLY", "SensingSpec", "SensingError",
+           "DEFAULT_NOISE_M", "DEFAULT_RATE_HZ", "MAX_CLUTTER_RATE", "without_unread_settings"]
 
 #: Known perception modes.
 MODES = ("oracle", "twist", "tracked")
@@ -33,6 +34,9 @@ ASSOCIATIONS = ("named", "anonymous")
 #: What hides a moving obstacle from the ``tracked`` sensor: the static obstacles, or also the
 #: other moving obstacles' discs.
 OCCLUSIONS = ("static", "all")
+#: The settings only ``tracked`` perception reads: with ``oracle`` or ``twist`` a scenario's
+#: ``sensing:`` block and the command line refuse them.
+TRACKED_ONLY = ("noise_m", "rate_hz", "association", "detection_prob", "clutter_rate", "occlusion")
 #: Largest mean number of false detections per frame.
 MAX_CLUTTER_RATE = 1000.0
 #: Default position noise [m] (standard deviation per axis) of ``tracked``.
@@ -111,8 +115,17 @@ class SensingSpec:
                                                "(a named detection is a real obstacle)")
 
     def to_dict(self) -> dict[str, float | str]:
-        """The ``sensing:`` block of the YAML schema (the association keys only when not their
-        defaults)."""
+        """The ``sensing:`` block of the YAML schema: the mode alone unless ``tracked``, whose
+        association keys are written only when not their defaults."""
+        if self.mode != "tracked":
+            return {"mode": self.mode}
+        return self.identity()
+
+    def identity(self) -> dict[str, float | str]:
+        """Every setting that tells this spec from another, also the ones ``oracle`` and
+        ``twist`` do not read (the block as :meth:`to_dict` wrote it for every mode before those
+        were refused): what :meth:`~anyplan.world.scenario.Scenario.content_hash` hashes, so
+        that a scenario's hash, and the stored runs found by it, stay the same."""
         out: dict[str, float | str] = {"mode": self.mode, "noise_m": self.noise_m,
                                        "rate_hz": self.rate_hz}
         if self.association != "named":
@@ -124,3 +137,12 @@ class SensingSpec:
         if self.occlusion != "static":
             out["occlusion"] = self.occlusion
         return out
+
+
+def without_unread_settings(block: Any) -> Any:
+    """A ``sensing:`` block (as earlier versions wrote it, e.g. into a results database) without
+    the :data:`TRACKED_ONLY` keys when its mode is not ``tracked`` (nothing read them); anything
+    else unchanged."""
+    if not isinstance(block, dict) or block.get("mode") == "tracked":
+        return block
+    return {k: v for k, v in block.items() if k not in TRACKED_ONLY}
