@@ -103,7 +103,8 @@ def test_bench_resume_flag_and_refusal(tmp_path, tiny, capsys):
     (["--jobs", "0"], "--jobs must be >= 1"),
     (["--suite", "nope.yaml"], "nope.yaml: no such file"),
     (["--resume", "--db", "missing.db"], "does not exist"),
-    (["--planners", "straight", "--config", 'straight={"nope": 1}'], "unexpected keyword argument 'nope'"),
+    (["--planners", "straight", "--config", 'straight={"nope": 1}'],
+     "--config straight: unknown setting of planner 'straight' 'nope'"),
     (["--planners", "straight", "--config", "straight=[1"], "--config straight: not JSON"),
     (["--planners", "straight", "--config", "dovs={}"], "'dovs' is not in --planners"),
 ])

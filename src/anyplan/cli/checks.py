@@ -26,8 +26,8 @@ from anyplan.world import limits as L
 
 __all__ = [
     "seed", "time_limit", "sim_step", "actuation_noise", "localization_noise", "positive_seconds", "count",
-    "playback_speed", "writable_file", "writable_folder", "safe_name", "PLOT_SUFFIXES", "MAX_RUNS",
-    "MAX_TASKS", "MAX_JOBS", "MAX_PLAN_TIME_S", "MAX_ACTUATION_SIGMA", "MAX_LOCALIZATION_SIGMA",
+    "nonempty", "playback_speed", "writable_file", "writable_folder", "safe_name", "PLOT_SUFFIXES",
+    "MAX_RUNS", "MAX_TASKS", "MAX_JOBS", "MAX_PLAN_TIME_S", "MAX_ACTUATION_SIGMA", "MAX_LOCALIZATION_SIGMA",
     "SPEED_RANGE", "SIM_FLAGS",
     "flag_message"]
 
@@ -149,6 +149,18 @@ def count(most: int):  # noqa: ANN201 - an argparse type
         return n
 
     parse.__name__ = "count"
+    return parse
+
+
+def nonempty(what: str):  # noqa: ANN201 - an argparse type
+    """An argparse type: a string that is not empty (nor only spaces), which would otherwise
+    read as the current folder or as "not given"; ``what`` says what is expected."""
+    def parse(text: str) -> str:
+        if not text.strip():
+            raise argparse.ArgumentTypeError(f"empty; expected {what}")
+        return text
+
+    parse.__name__ = "nonempty"
     return parse
 
 

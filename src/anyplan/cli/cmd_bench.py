@@ -19,35 +19,45 @@ and the paper's own figures beside ours. Ctrl-C loses no finished run; --resume 
 missing ones."""
 
 
+#: What ``--suite`` expects, for the message about an empty one.
+_SUITE_WHAT = "a suite name, a folder or a comma-separated list of scenarios"
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the ``bench`` and ``report`` sub-commands."""
     p = sub.add_parser("bench", help="benchmark planners on a suite of scenarios",
                        description=DESCRIPTION)
-    p.add_argument("--suite", default="paper",
-                   help="'paper' (paper-1..3), 'random' (generated), a folder of scenario YAML "
-                        "files, or a comma-separated list of files/built-in names (default paper)")
-    p.add_argument("--planners", default=None,
+    p.add_argument("--suite", default="paper", type=checks.nonempty(_SUITE_WHAT),
+                   help="'paper' (paper-1..3), 'random' (generated), 'gaps' (a wall with a gap "
+                        "and walkers), a folder of scenario YAML files, or a comma-separated "
+                        "list of files/built-in names (default paper)")
+    p.add_argument("--planners", default=None, type=checks.nonempty("planner names"),
                    help="comma-separated planner names (default: the paper's comparison, "
                         f"{default_bench_planners()}; 'anyplan planners' lists them all)")
     p.add_argument("--config", action="append", default=[], metavar="NAME=JSON",
                    help="keyword config of one planner as a JSON object, e.g. "
-                        "'bitstar={\"time_budget_s\": 0.2}' (repeatable; recorded in plannerConfigs)")
+                        "'bitstar={\"time_budget_s\": 0.2}' (repeatable; checked as --set checks its "
+                        "values; recorded in plannerConfigs)")
     p.add_argument("--runs", type=int, default=30,
                    help=f"runs per (scenario, planner), at most {checks.MAX_RUNS} (default 30)")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
                    help="worker processes (default: the number of CPUs; 1 = no subprocess)")
-    p.add_argument("--db", default="results.db", help="SQLite results database (default results.db)")
-    p.add_argument("--out", default=None, help="folder for tables.md and tables.csv")
+    p.add_argument("--db", default="results.db", type=checks.nonempty("a database file"),
+                   help="SQLite results database (default results.db)")
+    p.add_argument("--out", default=None, type=checks.nonempty("a folder"),
+                   help="folder for tables.md and tables.csv")
     p.add_argument("--resume", action="store_true",
                    help="run only the runs missing from --db (after an interruption)")
     p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                   type=checks.nonempty("a scheduler address"),
                    help="run on this Dask scheduler (needs the 'dask' extra) instead of --jobs")
     p.add_argument("--seed", type=checks.seed, default=0,
                    help="master seed; run i uses a seed derived from (seed, i) (default 0)")
-    p.add_argument("--random-count", type=checks.count(1000), default=1,
-                   help="--suite random: scenarios per number of moving obstacles 1-6 (default 1)")
+    p.add_argument("--random-count", type=checks.count(1000), default=1, metavar="K",
+                   help="--suite random: K scenarios per number of moving obstacles 1-6; "
+                        "--suite gaps: 20 x K gap worlds (default 1)")
     p.add_argument("--random-seed", type=checks.seed, default=None,
-                   help="--suite random: generator seed (default: --seed)")
+                   help="--suite random or gaps: generator seed (default: --seed)")
     p.add_argument("--dt", type=checks.sim_step, default=0.05,
                    help="simulation step [s], in [0.001, 0.05] (default 0.05)")
     p.add_argument("--time-limit", type=checks.time_limit, default=None,
@@ -71,7 +81,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "OMPL's planners (optional ompl wheel) for --budget seconds per run, and store "
                        "best cost against planning time in the results database (progress table); "
                        "'anyplan report' draws it. Runs one at a time (wall-clock costs).")
-    q.add_argument("--suite", default="planning",
+    q.add_argument("--suite", default="planning", type=checks.nonempty(_SUITE_WHAT),
                    help="as for 'anyplan bench', or 'planning' (the default): the peers problem and "
                         "random cluttered worlds where the straight line is blocked")
     q.add_argument("--runs", type=checks.count(checks.MAX_RUNS), default=10,
@@ -81,11 +91,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument("--ompl", default="auto",
                    help="OMPL geometric planners, comma-separated, or 'none'; default 'auto': "
                         "BITstar,InformedRRTstar,RRTstar when the ompl wheel is installed, else none")
-    q.add_argument("--db", default="results.db", help="SQLite results database (default results.db)")
+    q.add_argument("--db", default="results.db", type=checks.nonempty("a database file"),
+                   help="SQLite results database (default results.db)")
     q.add_argument("--seed", type=checks.seed, default=0, help="master seed (default 0)")
     q.add_argument("--random-count", type=checks.count(1000), default=1,
-                   help="--suite random: see 'anyplan bench'; --suite planning: 4 x this many "
-                        "cluttered worlds (default 1)")
+                   help="--suite random or gaps: see 'anyplan bench'; --suite planning: 4 x this "
+                        "many cluttered worlds (default 1)")
     q.add_argument("--resume", action="store_true", help="run only the runs missing from --db")
     q.add_argument("--no-progress", action="store_true", help="no progress bar")
     q.set_defaults(func=_database_errors(cmd_bench_planning))
@@ -142,7 +153,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     """Run the bench, then print and write the tables."""
     from anyplan.experiments.db import ResultsDB, agent_settings_string
     from anyplan.experiments.runner import BenchInterrupted, parse_planners, run_bench
-    from anyplan.experiments.suites import resolve_suite
+    from anyplan.experiments.suites import resolve_suite, suite_size
     from anyplan.experiments.tables import (
         compare_planners,
         format_comparisons,
@@ -161,23 +172,28 @@ def cmd_bench(args: argparse.Namespace) -> int:
         raise _usage(f"bench: --jobs must be >= 1, got {args.jobs}")
     if args.jobs > checks.MAX_JOBS:
         raise _usage(f"bench: --jobs must be <= {checks.MAX_JOBS} (the stated limit), got {args.jobs}")
-    planners = parse_planners(args.planners or default_bench_planners(), args.config)
+    planners = parse_planners(default_bench_planners() if args.planners is None else args.planners,
+                              args.config)
+    from anyplan.cli.agent_options import check_config_options
+    from anyplan.experiments.runner import PlannerSpec
+
+    given = check_config_options({p.name: dict(p.config) for p in planners})
+    planners = [PlannerSpec(p.name, given[p.name]) for p in planners]
     if args.set_options or args.deterministic:
         from anyplan.cli.agent_options import bench_configs
-        from anyplan.experiments.runner import PlannerSpec
 
         cfgs = bench_configs(args, [p.name for p in planners], {p.name: dict(p.config) for p in planners})
         planners = [PlannerSpec(p.name, cfgs[p.name]) for p in planners]
+    known = suite_size(args.suite, args.random_count)
+    if known is not None:  # a named suite: refused before it is generated
+        _check_task_count(args.runs, known, len(planners))
     scenarios = resolve_suite(args.suite, random_seed=args.seed if args.random_seed is None
                               else args.random_seed, per_count=args.random_count)
     from anyplan.cli.perception_opts import apply_perception, tracker_settings
 
     scenarios = apply_perception("bench", scenarios, args)
     tracker = tracker_settings("bench", args, scenarios)
-    n_tasks = args.runs * len(scenarios) * len(planners)
-    if n_tasks > checks.MAX_TASKS:
-        raise _usage(f"bench: {args.runs} runs x {len(scenarios)} scenarios x {len(planners)} "
-                     f"planners = {n_tasks} runs, more than the limit of {checks.MAX_TASKS}")
+    _check_task_count(args.runs, len(scenarios), len(planners))
     from anyplan.simulation.simulator import SimConfig
 
     try:
@@ -236,6 +252,14 @@ def cmd_bench(args: argparse.Namespace) -> int:
             raise _usage(f"bench: --out {args.out}: cannot write ({exc.strerror})") from None
         print("\nwrote " + ", ".join(str(p) for p in paths))
     return 0
+
+
+def _check_task_count(runs: int, scenarios: int, planners: int) -> None:
+    """Refuse a bench of more than :data:`~anyplan.cli.checks.MAX_TASKS` runs in all."""
+    n_tasks = runs * scenarios * planners
+    if n_tasks > checks.MAX_TASKS:
+        raise _usage(f"bench: {runs} runs x {scenarios} scenarios x {planners} planners = "
+                     f"{n_tasks} runs, more than the limit of {checks.MAX_TASKS}")
 
 
 def cmd_bench_planning(args: argparse.Namespace) -> int:

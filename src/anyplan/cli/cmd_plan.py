@@ -20,14 +20,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("plan", help="plan a path among a scenario's static obstacles",
                        description="Plan start -> goal for the scenario's robot (a disc) among its "
                        "static obstacles; prints a summary and optionally writes JSON and a plot.")
-    p.add_argument("scenario", help="built-in scenario name (see 'anyplan scenarios') or YAML file")
+    p.add_argument("scenario", type=checks.nonempty("a built-in scenario name or a YAML file"),
+                   help="built-in scenario name (see 'anyplan scenarios') or YAML file")
     p.add_argument("--planner", default="bitstar", choices=PLANNERS,
                    help="planner (default bitstar)")
     p.add_argument("--time", type=float, default=DEFAULT_TIME_S,
                    help=f"time budget [s] for BIT* (default {DEFAULT_TIME_S})")
     p.add_argument("--seed", type=checks.seed, default=0, help="random seed >= 0 (default 0)")
-    p.add_argument("--json", default=None, metavar="FILE", help="write the result as JSON")
-    p.add_argument("--plot", default=None, metavar="FILE",
+    p.add_argument("--json", default=None, metavar="FILE", type=checks.nonempty("a file"),
+                   help="write the result as JSON")
+    p.add_argument("--plot", default=None, metavar="FILE", type=checks.nonempty("a file"),
                    help="write a picture (tree, samples, informed ellipse, path): .png, .svg or .pdf")
     p.add_argument("--format", default=None, choices=("png", "svg", "pdf"),
                    help="picture format (default: the suffix of --plot FILE)")

@@ -37,11 +37,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description="Simulate a planner on a scenario; writes DIR/result.json "
                        "and DIR/run.png (or --format svg/pdf) and prints a summary.", epilog=EXIT_CODES,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("scenario", help="built-in scenario name (see 'anyplan scenarios') or YAML file")
+    p.add_argument("scenario", type=checks.nonempty("a built-in scenario name or a YAML file"),
+                   help="built-in scenario name (see 'anyplan scenarios') or YAML file")
     p.add_argument("--planner", default=DEFAULT_PLANNER,
                    help=f"planner name (default {DEFAULT_PLANNER}; one of: {', '.join(AGENTS.names())})")
     p.add_argument("--seed", type=checks.seed, default=0, help="random seed >= 0 (default 0)")
-    p.add_argument("--out", default=None, help="output folder (default runs/SCENARIO-PLANNER-SEED)")
+    p.add_argument("--out", default=None, type=checks.nonempty("a folder"),
+                   help="output folder (default runs/SCENARIO-PLANNER-SEED)")
     p.add_argument("--dt", type=checks.sim_step, default=0.05,
                    help="simulation step [s], in [0.001, 0.05] (default 0.05)")
     p.add_argument("--time-limit", type=checks.time_limit, default=None,
@@ -57,13 +59,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-plot", action="store_true", help="do not write run.png")
     p.add_argument("--format", default="png", choices=("png", "svg", "pdf"),
                    help="picture format: DIR/run.png, run.svg or run.pdf (default png)")
-    p.add_argument("--animate", default=None, metavar="FILE",
+    p.add_argument("--animate", default=None, metavar="FILE", type=checks.nonempty("a file"),
                    help="also write an animation of the run (.gif, or .mp4 when ffmpeg is present)")
     p.add_argument("--speed", type=checks.playback_speed, default=4.0,
                    help="animation playback speed, x real time (default 4)")
     add_perception_options(p)
     add_tracker_option(p)
-    p.add_argument("--mcap", default=None, metavar="FILE",
+    p.add_argument("--mcap", default=None, metavar="FILE", type=checks.nonempty("a file"),
                    help="also write the run as an MCAP file with ROS 2 messages (poses, plans, "
                         "obstacles; for Foxglove, RViz, ros2 bag); needs the 'mcap' extra")
     add_agent_options(p)

@@ -7,7 +7,14 @@ from collections.abc import Sequence
 
 from anyplan.errors import UsageError
 from anyplan.world.scenario import Scenario
-from anyplan.world.sensing import ASSOCIATIONS, DEFAULT_NOISE_M, DEFAULT_RATE_HZ, MODES, OCCLUSIONS
+from anyplan.world.sensing import (
+    ASSOCIATIONS,
+    DEFAULT_NOISE_M,
+    DEFAULT_RATE_HZ,
+    MODES,
+    OCCLUSIONS,
+    TRACKED_ONLY,
+)
 
 __all__ = ["add_perception_options", "apply_perception", "add_tracker_option", "tracker_settings"]
 
@@ -15,6 +22,8 @@ __all__ = ["add_perception_options", "apply_perception", "add_tracker_option", "
 _FLAGS = {"mode": "--perception", "noise_m": "--sensor-noise", "rate_hz": "--sensor-rate",
           "association": "--sensor-association", "detection_prob": "--detection-prob",
           "clutter_rate": "--clutter-rate", "occlusion": "--sensor-occlusion"}
+#: The same fields -> the ``argparse`` destinations of their flags.
+_DESTS = {k: v[2:].replace("-", "_") for k, v in _FLAGS.items()}
 
 
 def add_perception_options(p: argparse.ArgumentParser) -> None:
@@ -51,20 +60,30 @@ def apply_perception(command: str, scenarios: Sequence[Scenario],
 
     Raises:
         UsageError: a bad setting (an unknown mode or association, a negative noise, a rate
-            that is not > 0, ...; exit code 2), naming its flag.
+            that is not > 0, ...; exit code 2), naming its flag, or a setting that only
+            ``tracked`` perception reads given for a scenario whose perception is not
+            ``tracked`` (nothing would read it).
     """
     from anyplan.simulation.perception import override_sensing
 
     try:
-        return [override_sensing(sc, args.perception, args.sensor_noise, args.sensor_rate,
-                                 association=args.sensor_association,
-                                 detection_prob=args.detection_prob,
-                                 clutter_rate=args.clutter_rate,
-                                 occlusion=args.sensor_occlusion)
-                for sc in scenarios]
+        out = [override_sensing(sc, args.perception, args.sensor_noise, args.sensor_rate,
+                                association=args.sensor_association,
+                                detection_prob=args.detection_prob,
+                                clutter_rate=args.clutter_rate,
+                                occlusion=args.sensor_occlusion)
+               for sc in scenarios]
     except ValueError as exc:  # a SensingError names its field; the flag is told here
         opt = _FLAGS.get(getattr(exc, "field", ""), "--perception")
         raise UsageError(f"{command}: {opt}: {exc}") from None
+    given = [_FLAGS[k] for k in TRACKED_ONLY if getattr(args, _DESTS[k]) is not None]
+    for scenario in out if given else ():
+        mode = "oracle" if scenario.sensing is None else scenario.sensing.mode
+        if mode != "tracked":
+            raise UsageError(f"{command}: {given[0]}: {scenario.name}'s perception is '{mode}'; "
+                             "sensor settings apply to tracked perception only "
+                             "(--perception tracked)")
+    return out
 
 
 def add_tracker_option(p: argparse.ArgumentParser) -> None:

@@ -1,7 +1,7 @@
 """Experiments: scenario suites, the parallel benchmark runner, the results database, tables.
 
 * :mod:`~anyplan.experiments.generate`: random scenarios whose moving obstacles cross the route.
-* :mod:`~anyplan.experiments.suites`: ``paper``, ``random``, a folder or a list of files.
+* :mod:`~anyplan.experiments.suites`: ``paper``, ``random``, ``gaps``, a folder or a list of files.
 * :mod:`~anyplan.experiments.runner`: :func:`run_bench` over processes or a Dask cluster.
 * :mod:`~anyplan.experiments.db`: :class:`ResultsDB`, an SQLite file in OMPL's benchmark layout.
 * :mod:`~anyplan.experiments.tables`: the paper's Tables 2-3 from the database.

@@ -5,7 +5,7 @@
 * ``paper``: the built-in ``paper-1``, ``paper-2``, ``paper-3`` (1, 2 and 3 moving obstacles);
 * ``random``: generated scenarios (:mod:`anyplan.experiments.generate`), ``per_count`` for each
   number of moving obstacles 1-6, from ``random_seed``;
-* ``gaps``: 20 ``per_count`` gap worlds (:mod:`anyplan.experiments.gaps`) from ``random_seed``;
+* ``gaps``: 20 x ``per_count`` gap worlds (:mod:`anyplan.experiments.gaps`) from ``random_seed``;
 * a folder: every ``*.yaml`` / ``*.yml`` file in it, sorted by name;
 * a comma-separated list of scenario files or built-in names.
 
@@ -22,7 +22,7 @@ from anyplan.experiments.generate import random_suite
 from anyplan.registry import Registry
 from anyplan.world.scenario import Scenario, load_scenario
 
-__all__ = ["resolve_suite", "PAPER_SUITE", "SUITES", "SuiteError"]
+__all__ = ["resolve_suite", "suite_size", "PAPER_SUITE", "SUITES", "SuiteError"]
 
 PAPER_SUITE = ("paper-1", "paper-2", "paper-3")
 
@@ -52,15 +52,31 @@ SUITES: Registry[Callable[[int, int], list[Scenario]]] = Registry("suite")
 SUITES.register("paper", _paper)
 SUITES.register("random", _random)
 SUITES.register("gaps", _gaps)
+#: How many scenarios a named suite has for a ``per_count``, known before it is built.
+_SIZES: dict[str, Callable[[int], int]] = {
+    "paper": lambda per_count: len(PAPER_SUITE),
+    "random": lambda per_count: 6 * per_count,  # numbers of moving obstacles 1-6
+    "gaps": lambda per_count: 20 * per_count,
+}
+
+
+def suite_size(suite: str, per_count: int = 1) -> int | None:
+    """How many scenarios :func:`resolve_suite` returns for a named suite, computed without
+    building it (to refuse a bench that is too large before generating it); None for a folder,
+    a list or a suite whose size is not known in advance."""
+    size = _SIZES.get(suite)
+    return size(per_count) if size is not None and suite in SUITES else None
 
 
 def resolve_suite(suite: str, random_seed: int = 0, per_count: int = 1) -> list[Scenario]:
     """The scenarios of ``suite`` (see the module docstring).
 
     Raises:
-        SuiteError: an empty folder or list, or two scenarios with one name.
+        SuiteError: an empty name, folder or list, or two scenarios with one name.
         ScenarioError, UnknownNameError: a file or name that does not load.
     """
+    if not suite.strip():  # Path("") is the current folder: never read it by accident
+        raise SuiteError.about("suite", ": empty (no suite name, folder, scenario names or files)")
     if suite in SUITES:
         scenarios = SUITES.get(suite)(random_seed, per_count)
     elif Path(suite).is_dir():
