@@ -117,3 +117,45 @@ def test_no_collision_gives_none():
     res = simulate(scenario_from_dict(d), _Parked(), seed=0, config=SimConfig(time_limit=1.0))
     assert not res.collision and res.collision_robot_caused is None
     assert res.collision_approach_speed_mps is None
+
+
+class _Dash(Agent):
+    name = "dash"
+
+    def reset(self, scenario, rng):
+        pass
+
+    def act(self, obs):
+        return Command(1.0, 0.0)
+
+
+def test_the_contact_is_classified_at_the_contact_instant_not_at_the_steps_start():
+    # The robot (r 0.2 m) drives +x at 1 m/s from (1, 3) (a_max dt = 1 m/s: at full speed from
+    # the first step); a disc D (r 0.05 m, reach 0.25 m) moves at w = (-4, -5) m/s. It is placed
+    # so that the two first touch at t_c = 0.24 s (inside the step [0.2, 0.25]) with the disc
+    # at 120 degrees from the robot's heading, behind its centre: D(t_c) = p(t_c) + 0.25 n,
+    # n = (cos 120, sin 120). The relative velocity w - u = (-5, -5) enters the circle there
+    # ((w - u) . n < 0), so on that straight relative line t_c is the first contact. At contact
+    # the robot moves away from the disc: approach speed u . n = -0.5 m/s, not robot-caused.
+    # At the step's start (0.04 s earlier) the disc was still ahead of the robot's centre.
+    dt, t_c, reach = 0.05, 0.24, 0.25
+    u, w = np.array([1.0, 0.0]), np.array([-4.0, -5.0])
+    n = np.array([math.cos(math.radians(120.0)), math.sin(math.radians(120.0))])
+    p_c = np.array([1.0, 3.0]) + u * t_c
+    q0 = p_c + reach * n - w * t_c  # the disc at t = 0
+    assert float((w - u) @ n) < 0.0
+    d = small_scenario_dict(
+        robot={"start": [1.0, 3.0, 0.0], "goal": [7.0, 3.0], "radius": 0.2, "v_max": 1.0,
+               "omega_max": 0.8, "a_max": 20.0, "alpha_max": 1.0},
+        static_obstacles=[],
+        dynamic_obstacles=[{"name": "D", "type": "waypoints", "radius": 0.05,
+                            "keyframes": [[0.0, *q0], [1.0, *(q0 + w)]]}])
+    res = simulate(scenario_from_dict(d), _Dash(), seed=0, config=SimConfig(dt=dt, time_limit=0.5))
+    assert res.collision and res.collision_with == "D"
+    assert res.collision_time_s - dt <= t_c <= res.collision_time_s
+    assert res.collision_time_s == pytest.approx(0.25)
+    assert res.collision_approach_speed_mps == pytest.approx(float(u @ n), abs=1e-6)  # -0.5
+    assert res.collision_robot_caused is False
+    # The same classification at the step's start would differ: robot-caused (+0.18 m/s).
+    t0 = res.collision_time_s - dt
+    assert robot_caused(u, np.array([1.0, 3.0]) + u * t0, q0 + w * t0)

@@ -139,3 +139,73 @@ def test_observations_announce_motions_only_when_configured():
         o = agent.obs_log[0].obstacles[0]
         assert o.v == 0.0  # waiting for its start time
         assert (o.motion is sc.moving_obstacles[0].motion) == announce
+
+
+class ConstantCommand(Agent):
+    """Asks for the same command every step."""
+
+    name = "constant"
+
+    def __init__(self, v: float) -> None:
+        self.v = v
+
+    def reset(self, scenario, rng):
+        pass
+
+    def act(self, obs: Observation) -> Command:
+        return Command(self.v, 0.0)
+
+
+def test_a_thin_wall_crossed_between_two_steps_is_a_collision():
+    # A robot (r 0.1 m) at 20 m/s (1 m a step; a_max dt = 50 m/s, so it drives at 20 m/s from
+    # the first step) heading +x from x = 1.3 along y = 3, a 5 cm wall W at x in [1.975, 2.025]
+    # for y in [0, 4]. Closed form: first contact when x + 0.1 = 1.975, at t = 0.575 / 20 =
+    # 0.02875 s, inside the first step; both ends of that step (x = 1.3 and x = 2.3) are clear.
+    r, speed, dt = 0.1, 20.0, 0.05
+    d = small_scenario_dict(
+        robot={"start": [1.3, 3.0, 0.0], "goal": [7.0, 5.0], "radius": r, "v_max": speed,
+               "omega_max": 0.8, "a_max": 1000.0, "alpha_max": 1.0},
+        static_obstacles=[{"name": "W", "type": "rectangle", "center": [2.0, 2.0], "size": [0.05, 4.0]}],
+        dynamic_obstacles=[])
+    res = simulate(scenario_from_dict(d), ConstantCommand(speed), seed=0,
+                   config=SimConfig(dt=dt, time_limit=0.2))
+    t_contact = (1.975 - r - 1.3) / speed
+    tr = res.trajectory_array
+    # The step's ends, independently: both clear of the wall's faces by more than r.
+    assert tr[0, 1] == pytest.approx(1.3) and tr[1, 1] == pytest.approx(2.3)
+    assert 1.975 - tr[0, 1] > r and tr[1, 1] - 2.025 > r
+    assert res.collision and res.collision_with == "W"
+    assert res.collision_time_s - dt <= t_contact <= res.collision_time_s
+    assert res.collision_time_s == pytest.approx(dt)
+    # The chord runs through the wall: clearance 0 - r, not the end point's +0.175 m.
+    assert res.min_clearance_m == pytest.approx(-r, abs=1e-9)
+    # Head-on into the wall's face at full speed.
+    assert res.collision_robot_caused is True
+    assert res.collision_approach_speed_mps == pytest.approx(speed)
+
+
+def test_a_disc_crossing_the_robot_between_two_steps_is_a_collision():
+    # A parked robot (r 0.3 m) at (3, 3); a disc F (r 0.1 m) at 20 m/s along y = 3.2, at x = 3
+    # at t = 0.125 s, the middle of the step [0.1, 0.15]. Closed form: closest approach 0.2 m
+    # (clearance 0.2 - 0.4 = -0.2 m); first contact when dx^2 + 0.2^2 = 0.4^2, at
+    # t = 0.125 - sqrt(0.12) / 20 = 0.1077 s. At the step's ends dx = -0.5 and +0.5 m: clearance
+    # sqrt(0.29) - 0.4 = +0.139 m, and more at every earlier step end.
+    speed, dt, t_mid = 20.0, 0.05, 0.125
+    x0 = 3.0 - speed * t_mid
+    d = small_scenario_dict(
+        robot={"start": [3.0, 3.0, 0.0], "goal": [7.0, 5.0], "radius": 0.3, "v_max": 0.5,
+               "omega_max": 0.8, "a_max": 0.5, "alpha_max": 1.0},
+        static_obstacles=[],
+        dynamic_obstacles=[{"name": "F", "type": "waypoints", "radius": 0.1,
+                            "keyframes": [[0.0, x0, 3.2], [0.3, x0 + speed * 0.3, 3.2]]}])
+    sc = scenario_from_dict(d)
+    res = simulate(sc, ConstantCommand(0.0), seed=0, config=SimConfig(dt=dt, time_limit=0.3))
+    t_contact = t_mid - math.sqrt(0.4**2 - 0.2**2) / speed
+    # Every step end up to the contact step, independently: clear.
+    f = sc.moving_obstacles[0]
+    for t in np.arange(0, 4) * dt:
+        assert math.hypot(*(f.position(t) - np.array([3.0, 3.0]))) - 0.4 > 0.13
+    assert res.collision and res.collision_with == "F"
+    assert res.collision_time_s - dt <= t_contact <= res.collision_time_s
+    assert res.collision_time_s == pytest.approx(0.15)
+    assert res.min_clearance_m == pytest.approx(0.2 - 0.4, abs=1e-9)
