@@ -135,10 +135,6 @@ def test_no_cycle_between_parts_of_one_tier() -> None:
     assert not cycles, f"parts of anyplan that import each other: {cycles}"
 
 
-def test_no_known_break_left() -> None:
-    assert not KNOWN, "issue 13 removed every known break: keep the list empty"
-
-
 @pytest.mark.parametrize(
     ("source", "expected"),
     [

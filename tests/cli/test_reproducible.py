@@ -37,7 +37,8 @@ def test_the_same_deterministic_command_twice_gives_the_same_result(tmp_path):
     ra, rb = without_wall_clock(a), without_wall_clock(b)
     assert "wall_time_s" not in ra and "plan_time_s" not in ra["extra"]
     assert ra == rb
-    assert a["virtual_obstacles"] and a["replans"] >= 0 and a["plans"]  # the loop did plan around obstacles
+    assert a["virtual_obstacles"] and a["plans"]  # the loop did plan around obstacles
+    assert a["replans"] == len(a["planning_times_s"]) - 1  # every planning but the first is a replanning
     # --set gives the same settings by hand (and --set overrides --deterministic's).
     c = _run(tmp_path, "c", "--set", "planning_delay=0.1", "--set", "batches_per_plan=2",
              "--set", "max_time_s=10")
@@ -105,6 +106,52 @@ def test_other_planners_deterministic_settings_repeat(planner):
             for _ in range(2)]
     assert runs[0].reproducible_dict() == runs[1].reproducible_dict()
     assert len(runs[0].trajectory) > 100
+
+
+@pytest.mark.parametrize("planner", ["seq-bitstar", "st-bitstar"])
+def test_deterministic_settings_give_the_same_run_on_a_slower_machine(planner):
+    # Running twice on the same machine cannot show a deterministic run that still reads the
+    # wall clock. The second run here is on a "slower machine": every replanning takes 0.15 s
+    # more of wall clock. A fixed planning delay (0.1 s) must start every motion 0.1 s after
+    # its call on both; a measured one would start the second 0.25 s after (1.5 x 0.15 s on
+    # the 0.05 s grid). paper-1 with a 2 m sensing range, so that the robot replans.
+    import dataclasses
+    import time
+
+    from anyplan.agents.base import AGENTS, make_agent
+    from anyplan.simulation import SimConfig, simulate
+    from anyplan.world import load_scenario
+
+    slow_s = 0.15
+    cfg = build_agent_config(AGENTS.get(planner), planner, {}, deterministic=True)
+    sc = load_scenario("paper-1")
+    sc = dataclasses.replace(sc, robot=dataclasses.replace(sc.robot, sensing_range=2.0))
+
+    def slower(agent):
+        reset = agent.reset
+
+        def slow_reset(scenario, rng):
+            reset(scenario, rng)
+            inner = agent.loop.replan
+
+            def replan(*args, **kwargs):
+                time.sleep(slow_s)
+                return inner(*args, **kwargs)
+
+            agent.loop.replan = replan
+
+        agent.reset = slow_reset
+        return agent
+
+    config = SimConfig(time_limit=6.0)
+    fast = simulate(sc, make_agent(planner, **cfg), seed=4, config=config)
+    slow = simulate(sc, slower(make_agent(planner, **cfg)), seed=4, config=config)
+    assert fast.replans >= 1  # a delay after a first measured call exists
+    assert min(slow.planning_times_s) >= slow_s  # every replanning was slower
+    assert [p["t_start"] - p["t"] for p in slow.plans] == [p["t_start"] - p["t"] for p in fast.plans]
+    assert slow.trajectory == fast.trajectory
+    assert slow.extra["statuses"] == fast.extra["statuses"]
+    assert slow.reproducible_dict() == fast.reproducible_dict()
 
 
 def test_a_benchmark_with_fixed_planners_names_them_in_a_bad_set(capsys):
