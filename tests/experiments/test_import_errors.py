@@ -102,6 +102,14 @@ def test_window_and_copy_counts_are_refused_at_once(tmp_path, capsys, argv, word
     assert not (tmp_path / "o").exists()
 
 
+def test_a_recording_shorter_than_a_window_is_refused_not_written_empty(tmp_path, capsys):
+    # 80 annotations 0.4 s apart: 31.6 s, less than one 40 s window ("wrote 0 scenarios", exit 0)
+    _refused(capsys, ["import-crowd", str(_small(tmp_path)), "--out", str(tmp_path / "o"),
+                      "--window", "40"], "small.txt:", "lasts 31.6 s", "less than one window of 40 s",
+             "--window")
+    assert not (tmp_path / "o").exists()
+
+
 @pytest.mark.parametrize("shift", ["nan", "0", "-1", "inf", "2e6"])
 def test_copy_shift_must_be_finite_and_positive(tmp_path, capsys, shift):
     _refused(capsys, ["import-crowd", str(_small(tmp_path)), "--out", str(tmp_path / "o"),

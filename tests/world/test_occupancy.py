@@ -307,6 +307,24 @@ def test_origin_limit_holds_with_an_explicit_arena(tmp_path):
         load_scenario(f)
 
 
+def test_a_map_wholly_outside_its_explicit_arena_is_refused(tmp_path):
+    # within the coordinate limit but 5 km away from the 5 x 3 m arena: the map could hold
+    # nothing the robot meets (a wrong origin), and was accepted in silence
+    write_pgm(tmp_path / "m.pgm", np.array([[255, 255, 255, 255], [0, 255, 255, 255]]))
+    write_yaml(tmp_path / "m.yaml", "m.pgm", resolution=1.0, origin=(5000.0, 0.0, 0.0))
+    f = tmp_path / "s.yaml"
+    f.write_text("name: s\nstatic_map: m.yaml\narena: {width: 5, height: 3, origin: [0, 0]}\n"
+                 "robot: {start: [2.5, 0.5, 0], goal: [4.5, 0.5], radius: 0.2, v_max: 1, "
+                 "omega_max: 1, a_max: 1, alpha_max: 1}\n")
+    with pytest.raises(ScenarioError, match=r"static_map: the map \[5000, 5004\] x \[0, 2\] lies "
+                                            r"outside the arena \[0, 5\] x \[0, 3\]") as info:
+        load_scenario(f)
+    assert "\n" not in str(info.value)
+    # overlapping it by one cell is a map of part of the arena: accepted
+    write_yaml(tmp_path / "m.yaml", "m.pgm", resolution=1.0, origin=(4.0, 2.0, 0.0))
+    assert load_scenario(f).static_map is not None
+
+
 @pytest.mark.parametrize(("res", "origin", "words"), [
     ("5000", "[0, 0, 0]", "far corner (15000, 5000) is beyond the coordinate limit"),  # 3 x 1 cells
     ("1e300", "[0, 0, 0]", "beyond the coordinate limit"),

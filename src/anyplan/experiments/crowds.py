@@ -244,8 +244,8 @@ def crowd_scenarios(tracks: Mapping[int, np.ndarray], name: str,
     height = float(allp[:, 2].max() - ymin + 2 * opt.margin_m)
     t_end = float(max(tr[-1, 0] for tr in tracks.values()))
     period = t_end + 0.4  # one annotation interval after the last frame: no two copies' samples meet
-    n_win = _count_windows(t_end, opt, src)
     _check_shift(opt, period, src)
+    n_win = _count_windows(t_end, opt, src)
     shifted = {pid: np.column_stack([tr[:, 0], tr[:, 1] + sx, tr[:, 2] + sy])
                for pid, tr in tracks.items()}
     along_x = width >= height
@@ -326,8 +326,9 @@ def _check_arena(tracks: Mapping[int, np.ndarray], allp: np.ndarray, margin: flo
 def _count_windows(t_end: float, opt: CrowdOptions, src: str) -> int:
     """The number of windows, refused beyond the stated limit before any is made."""
     q = (t_end - opt.window_s) / opt.step_s  # may be huge (a tiny step) or inf, never NaN
-    if q < 0.0:
-        return 0
+    if q < 0.0:  # not one window: an import that writes nothing is refused, not silent
+        raise CrowdError.about(src, f": the recording lasts {t_end:g} s, less than one window of "
+                               f"{opt.window_s:g} s ({{window_s}})", "window_s")
     if q < 2 * L.MAX_IMPORT_SCENARIOS:
         n = int(math.floor(q + 1e-9)) + 1
         if n <= L.MAX_IMPORT_SCENARIOS:

@@ -235,6 +235,12 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
         width = c.number(arena["width"], "arena.width", positive=True, hi=L.MAX_ARENA_M)
         height = c.number(arena["height"], "arena.height", positive=True, hi=L.MAX_ARENA_M)
         ox, oy = c.vector(arena.get("origin", [0.0, 0.0]), "arena.origin", 2)
+        if smap is not None:
+            mx0, my0, mx1, my1 = smap.bounds
+            if mx1 <= ox or mx0 >= ox + width or my1 <= oy or my0 >= oy + height:
+                raise c.fail("static_map", f"the map [{mx0:g}, {mx1:g}] x [{my0:g}, {my1:g}] lies "
+                                           f"outside the arena [{ox:g}, {ox + width:g}] x "
+                                           f"[{oy:g}, {oy + height:g}] (check its origin or arena.origin)")
     else:
         assert smap is not None
         ox, oy, x1, y1 = smap.bounds
