@@ -11,7 +11,7 @@ from anyplan.planning.sequential import SequentialBITStar, SequentialConfig, shr
 from anyplan.prediction import ConstantTwistPredictor, PredictedObstacle
 from anyplan.simulation.simulator import observe
 from anyplan.trajectory.motion import plan_motion
-from anyplan.world import RobotState, UnicycleMotion, load_scenario
+from anyplan.world import RobotSpec, RobotState, UnicycleMotion, load_scenario
 
 
 def _loop(scenario, cfg=None, seed=0):
@@ -253,23 +253,65 @@ def test_a_motion_the_model_verified_is_not_checked_again(monkeypatch):
     assert calls and calls[0] is not trusted[0]
 
 
-def test_obstacle_parked_on_the_goal_makes_the_robot_wait_or_report():
-    sc = load_scenario("paper-1")
-    spec = sc.robot
-    # A slow obstacle crossing the goal about when the robot arrives: no detour can help, but a
-    # later arrival can; the squares are shrunk so the goal stays reachable.
-    parked = PredictedObstacle("G", 0.3, UnicycleMotion(13.5, 2.0, np.pi / 2, 0.12))
-    loop, _, _ = _loop(sc, SequentialConfig(prediction_dt=None))
-    res = loop.replan(np.array(spec.start[:2]), np.array(spec.goal), [parked], 0.0)
-    assert res.status in ("collision_free", "waiting", "collision_predicted")
-    for v in res.virtual_obstacles:
-        box = ObstacleSet([v.shape])
-        assert box.clearance(spec.goal) >= spec.radius
-        assert box.clearance(spec.start[:2]) >= spec.radius
-    if res.collision_free:
-        t = np.arange(res.motion.t_start, res.motion.t_end, 0.01)
-        gap = np.hypot(*(res.motion.positions(t) - parked.positions(t)).T) - 0.6
-        assert gap.min() >= 0.05 - 0.004
+def _corridor_crossing(wait_delays_s):
+    """A corridor 1.3 m wide (the arena itself: y in [0, 1.3]) from (1, 0.65) to (4, 0.65),
+    and a disc of radius 0.3 crossing it at x = 2.5 at 0.5 m/s (y = -1.75 + 0.5 t). With the
+    margin its contact distance to the robot's centre line is 0.3 + 0.3 + 0.05 = 0.65, so it
+    blocks the corridor from t = 3.5 s (y = 0) to t = 6.1 s (y = 1.3). The robot (0.4 m/s,
+    0.4 m/s^2) departing at once reaches x = 2.5 at t = 1 + 1.3 / 0.4 = 4.25 s: in the middle
+    of it. No detour exists: a square (side 2 (0.3 + 0.3) = 1.2 m) at the collision leaves
+    0.05 m on each side of the corridor, less than the robot. Only a later departure helps."""
+    spec = RobotSpec(start=(1.0, 0.65, 0.0), goal=(4.0, 0.65), radius=0.3, v_max=0.4,
+                     omega_max=0.4, a_max=0.4, alpha_max=1.0)
+    corridor = ObstacleSet([], bounds=(0.0, 0.0, 5.0, 1.3))
+    state = RobotState(*spec.start, 0.0, 0.0)
+
+    def motion_fn(path, shapes, delay):
+        obst = corridor.with_shapes(shapes) if shapes else corridor
+        return plan_motion(path, spec, state, obst, delay, margin=0.015)
+
+    cfg = SequentialConfig(prediction_dt=None, batches_per_plan=2, prove_blocked=True,
+                           wait_delays_s=wait_delays_s)
+    loop = SequentialBITStar(corridor, robot_radius=0.3, plan_radius=0.33, motion=motion_fn,
+                             config=cfg, rng=np.random.default_rng(0))
+    crossing = PredictedObstacle("X", 0.3, UnicycleMotion(2.5, -1.75, np.pi / 2, 0.5))
+    res = loop.replan(np.array(spec.start[:2]), np.array(spec.goal), [crossing], 0.0)
+
+    def gap(motion):  # dense, independent of the loop's own prediction check
+        t = np.arange(motion.t_start, motion.t_end + 0.01, 0.01)
+        return float((np.hypot(*(motion.positions(t) - crossing.positions(t)).T) - 0.6).min())
+
+    return res, motion_fn, gap
+
+
+def test_a_corridor_blocked_for_a_while_makes_the_robot_depart_later():
+    delays = (0.5, 1.0, 2.0, 3.0, 5.0, 8.0, 12.0)
+    res, motion_fn, gap = _corridor_crossing(delays)
+    straight = np.array([[1.0, 0.65], [4.0, 0.65]])
+    # Departing d s late, the robot is at x = 2.5 at 4.25 + d s, and the disc is off the
+    # centre line by 0.65 m (y >= 1.3) only from 6.1 s: any d < 1.85 s collides; d = 2 s still
+    # clips the disc on the approach, 3 s passes behind it (the dense check decides).
+    assert gap(motion_fn(straight, [], 0.0)) < 0.0
+    first_clear = next(d for d in delays if gap(motion_fn(straight, [], d)) >= 0.05)
+    assert first_clear == 3.0
+    assert res.status == "waiting" and res.collision_free and res.collision is None
+    assert res.delay_s == first_clear > 0.0
+    np.testing.assert_allclose(res.path, straight)  # the only way; no square is kept
+    assert res.iterations == 1 and res.virtual_obstacles == []
+    assert res.motion.t_start == pytest.approx(first_clear)  # at rest until then
+    assert gap(res.motion) >= 0.05 - 0.004  # the margin, up to the dense step at 0.4 m/s
+
+
+def test_a_corridor_blocked_longer_than_any_delay_reports_the_predicted_collision():
+    delays = (0.5, 1.0, 2.0)  # all too short (see the test above)
+    res, motion_fn, gap = _corridor_crossing(delays)
+    assert all(gap(motion_fn(res.path, [], d)) < 0.0 for d in (0.0, *delays))
+    assert res.status == "collision_predicted" and not res.collision_free
+    # the best effort: the straight departure at once, with its first predicted collision
+    assert res.delay_s == 0.0 and res.motion.t_start == 0.0
+    np.testing.assert_allclose(res.path, [[1.0, 0.65], [4.0, 0.65]])
+    assert res.collision is not None and res.collision.obstacle == "X"
+    assert 3.5 <= res.collision.t <= 4.25  # after the disc enters, before the robot is at x = 2.5
 
 
 def test_config_validation_names_the_field():

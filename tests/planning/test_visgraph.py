@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import heapq
 import math
 
 import numpy as np
 import pytest
-from planning_problems import PEERS_POINT_OPTIMUM, box, peers_obstacles, peers_problem
+from planning_problems import PEERS_POINT_OPTIMUM, PEERS_RECTS, box, peers_obstacles, peers_problem
 
 from anyplan.geometry import Circle, ObstacleSet, Polygon
 from anyplan.planning import PlannerStatus, Problem, VisGraphPlanner, lower_bound, shortest_path
@@ -114,8 +115,72 @@ def test_peers_inflated_bounds_and_planner():
     res = planner.result()
     assert res.lower_bound is not None and res.lower_bound <= res.cost < res.lower_bound * 1.001
     assert p.path_valid(res.path)
-    # Square (Minkowski-box) inflation is an upper bound for a disc robot (its optimum: 24.0463).
-    assert res.cost < 24.0463
+    # Closed form for the disc robot: the point robot's via corners (3,7) (5,7) (7,4) (9,4)
+    # (10.5,8), each rounded to a circle of radius r. The walls are r or more away from the
+    # path. The path is tangent segments plus arcs. A corner is passed with the obstacle on the
+    # right (rho = +r: over box 1, left of box 3) or on the left (rho = -r: under box 2). The
+    # tangent from circle (c1, rho1) to (c2, rho2) with centre distance L at angle phi has the
+    # direction phi - asin((rho1 - rho2) / L) and the length sqrt(L^2 - (rho1 - rho2)^2); each
+    # arc is r times the turn between the two tangents' directions.
+    r = 0.25
+    via = [((1.0, 1.0), 0.0), ((3.0, 7.0), r), ((5.0, 7.0), r), ((7.0, 4.0), -r), ((9.0, 4.0), -r),
+           ((10.5, 8.0), r), ((14.0, 10.0), 0.0)]
+    heading, exact = [], 0.0
+    for (c1, r1), (c2, r2) in zip(via, via[1:], strict=False):
+        big_l = math.dist(c1, c2)
+        heading.append(math.atan2(c2[1] - c1[1], c2[0] - c1[0]) - math.asin((r1 - r2) / big_l))
+        exact += math.sqrt(big_l ** 2 - (r1 - r2) ** 2)
+    exact += sum(r * abs(b - a) for a, b in zip(heading, heading[1:], strict=False))  # |turns| < pi
+    assert res.lower_bound <= exact + 1e-9 and exact <= res.cost + 1e-9
+    assert res.cost < exact * (1.0 + 1e-4)
+    # Square (Minkowski-box) inflation is an upper bound for a disc robot. Its optimum is
+    # computed here by brute force: Dijkstra over the complete visibility graph of the start,
+    # the goal and the inflated boxes' corners that lie inside the arena shrunk by r. Its
+    # path is the polyline through the grown via corners (24.0463 m).
+    box_cost = _box_inflated_optimum(PEERS_RECTS, (0.0, 0.0, 15.0, 11.0), (1.0, 1.0), (14.0, 10.0), r)
+    grown_via = [(1.0, 1.0), (2.75, 7.25), (5.25, 7.25), (6.75, 3.75), (9.25, 3.75), (10.25, 8.25),
+                 (14.0, 10.0)]
+    assert box_cost == pytest.approx(sum(map(math.dist, grown_via, grown_via[1:])), abs=1e-9)
+    assert res.cost < box_cost
+
+
+def _box_inflated_optimum(rects, bounds, start, goal, r):
+    """Shortest point-robot path among the boxes grown by r (test-local, no anyplan code)."""
+    grown = [(x0 - r, y0 - r, x1 + r, y1 + r) for x0, y0, x1, y1 in rects]
+
+    def blocked(p, q):  # does pq enter a grown box's open interior? (Liang-Barsky clipping)
+        for x0, y0, x1, y1 in grown:
+            dx, dy = q[0] - p[0], q[1] - p[1]
+            t0, t1 = 0.0, 1.0
+            for den, num in ((-dx, p[0] - x0), (dx, x1 - p[0]), (-dy, p[1] - y0), (dy, y1 - p[1])):
+                if den == 0.0:
+                    t0 = t0 if num >= 0.0 else 2.0
+                elif den < 0.0:
+                    t0 = max(t0, num / den)
+                else:
+                    t1 = min(t1, num / den)
+            tm = 0.5 * (t0 + t1)
+            mx, my = p[0] + tm * dx, p[1] + tm * dy
+            if t1 - t0 > 1e-12 and x0 + 1e-9 < mx < x1 - 1e-9 and y0 + 1e-9 < my < y1 - 1e-9:
+                return True
+        return False
+
+    lo_x, lo_y, hi_x, hi_y = bounds[0] + r, bounds[1] + r, bounds[2] - r, bounds[3] - r
+    nodes = [start, goal] + [(x, y) for x0, y0, x1, y1 in grown for x in (x0, x1) for y in (y0, y1)
+                             if lo_x <= x <= hi_x and lo_y <= y <= hi_y]
+    dist, todo = {0: 0.0}, [(0.0, 0)]
+    while todo:
+        d, i = heapq.heappop(todo)
+        if i == 1:
+            return d
+        if d > dist[i]:
+            continue
+        for j, q in enumerate(nodes):
+            nd = d + math.dist(nodes[i], q)
+            if j != i and nd < dist.get(j, math.inf) and not blocked(nodes[i], q):
+                dist[j] = nd
+                heapq.heappush(todo, (nd, j))
+    return math.inf
 
 
 def test_infeasible_and_invalid_endpoints():
