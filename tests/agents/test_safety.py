@@ -16,7 +16,9 @@ from anyplan.geometry.collision import ObstacleSet
 from anyplan.prediction.base import PredictedObstacle
 from anyplan.prediction.collision import first_collision
 from anyplan.simulation import SimConfig, simulate
-from anyplan.trajectory.motion import brake_to_rest, plan_motion
+from anyplan.trajectory.brake import SwerveSegment
+from anyplan.trajectory.motion import brake_to_rest, plan_motion, swerve_trajectory
+from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world import RobotSpec, RobotState, load_scenario
 from anyplan.world.motion import UnicycleMotion
 
@@ -92,6 +94,46 @@ def test_far_collision_is_stoppable_near_one_is_not():
     assert d2.predicted_clearance_m == pytest.approx(0.1, abs=2e-3)
 
 
+def test_a_motion_whose_brake_would_strike_a_wall_is_not_stoppable():
+    # The robot drives straight down at the room's bottom wall (y = 0) at 1 m/s, its centre
+    # 2.1 m above it; braking at a_max = 0.3 m/s^2 takes 1 / 0.6 = 1.67 m, so braking now stops
+    # it at y = 0.43, clear of the wall. The proposed motion drives on for 0.5 s and then swerves
+    # away (a 0.5 m turning radius), its centre never below y = 0.85, to rest next to a
+    # parked disc P that it strikes about 4 s on. The robot acts again only after committing
+    # 0.4 s (a check period and a planning delay): by then it is at y = 1.7, still heading
+    # straight down, and braking would stop its centre at y = 0.03, 0.27 m into the wall. So the
+    # motion is neither free to rest (P) nor stoppable (the wall): the guard must refuse it.
+    spec = RobotSpec(start=(3.0, 2.1, -math.pi / 2), goal=(11.0, 3.0), radius=0.3, v_max=1.0,
+                     omega_max=2.0, a_max=0.3, alpha_max=4.0)
+    room = ObstacleSet([], bounds=(0.0, 0.0, 12.0, 6.0))
+    state = RobotState(3.0, 2.1, -math.pi / 2, 1.0, 0.0)
+    down = SwerveSegment(3.0, 2.1, -math.pi / 2, 1.0, 0.0, 1.0, 0.0, spec.a_max, spec.alpha_max,
+                         0.0, 0.5)  # the twist held: straight down at 1 m/s
+    away = swerve_trajectory(RobotState(3.0, 1.6, -math.pi / 2, 1.0, 0.0), spec, room,
+                             spec.radius, 0.5, 1.0, 2.0, 1.0)
+    motion = Trajectory([down, *away.segments], kind="down+swerve")
+    p = motion.positions(np.linspace(0.0, motion.t_end, 2001))
+    assert p[:, 1].min() > spec.radius + 0.5 and p[:, 0].min() > 2.9  # clear of every wall
+    park = [_parked_disc("P", 5.6, 1.5)]
+    hit = first_collision(motion, park, spec.radius, margin=0.05)
+    assert hit is not None and hit.t > 3.5 and hit.robot_position[0] > 4.5
+    commit_s = 0.4
+    at = motion.state(commit_s)
+    assert (at.x, at.y, at.theta, at.v, at.omega) == pytest.approx((3.0, 1.7, -math.pi / 2, 1.0, 0.0))
+    stop_y = at.y - at.v**2 / (2.0 * spec.a_max)  # straight down, no turn left to make
+    assert stop_y == pytest.approx(0.0333, abs=1e-3) and stop_y < spec.radius - 0.25
+    assert state.y - state.v**2 / (2.0 * spec.a_max) > spec.radius + 0.1  # braking now: clear
+    # The escape's brake runs along x = 3, 2 m clear of P: the wall alone forbids it. With the
+    # wall 5 m lower the same motion is stoppable.
+    guard = SafetyGuard(spec, room)
+    assert guard.check(motion, park, 0.0, commit_s)[0] == "unsafe"
+    deep = SafetyGuard(spec, ObstacleSet([], bounds=(0.0, -5.0, 12.0, 6.0)))
+    assert deep.check(motion, park, 0.0, commit_s)[0] == "stoppable"
+    d = guard.decide(0.0, motion, None, state, park, commit_s)
+    assert d.kind in FALLBACK_KINDS and d.rule == "fallback" and "cannot stop" in d.reason
+    assert all(x.kind != "motion" for x in guard.decisions)
+
+
 def test_current_motion_is_kept_when_the_new_one_is_unsafe():
     guard = SafetyGuard(SPEC, ROOM)
     _state, motion = _cruising()
@@ -155,18 +197,37 @@ def _escape_free(traj, t, t_commit, spec, obstacles, preds):
     return static_ok and first_collision(Esc, preds, spec.radius, t_from=t, t_until=t_rest) is None
 
 
+def _commit_times(agent):
+    """For each logged decision, the earliest time [s] the robot can act again, from the
+    agent's own timing, not from the guard's log: it follows what was chosen at ``d.t`` until
+    its next check (one ``check_period_s``) and then through a replanning's delay. Each
+    replanning (``record.replan_times_s``) makes one decision; its delay is the time from
+    the replanning to the switch, at least a fixed ``planning_delay``."""
+    decisions, t_plans = agent.guard.decisions, agent.record.replan_times_s
+    assert len(decisions) == len(t_plans)
+    out = []
+    for d, t_plan in zip(decisions, t_plans, strict=True):
+        delay = d.t - t_plan
+        if agent.planning_delay != "measured":
+            assert delay >= float(agent.planning_delay) - 1e-9, (d, t_plan)
+        out.append(d.t + agent.check_period_s + delay)
+    return out
+
+
 def check_invariant(scenario, agent, result):
     """Every executed motion was predicted free over its stopping horizon when chosen, or was
-    the best fallback and is recorded as such."""
+    the best fallback and is recorded as such. A stoppable motion's escape brakes no earlier
+    than the robot can act again (:func:`_commit_times`), and is re-predicted from then."""
     spec, obst, preds = scenario.robot, scenario.obstacle_set(), _truth(scenario)
     decisions = agent.guard.decisions
     fallbacks = result.extra["fallbacks"]
+    commits = _commit_times(agent)
     # Every switch of the executed trajectory is a logged decision.
     for t, traj in agent.executed:
         assert any(d.trajectory is traj and abs(d.t - t) < 1e-9 and d.kind != "keep"
                    for d in decisions), t
     n_fb = 0
-    for d in decisions:
+    for d, t_act in zip(decisions, commits, strict=True):
         tr = d.trajectory
         if d.kind in ("motion", "keep"):
             if d.rule == "free_to_rest":
@@ -174,7 +235,9 @@ def check_invariant(scenario, agent, result):
                                        t_until=max(tr.t_end, d.t)) is None, d
             else:
                 assert d.rule == "stoppable"
-                assert _escape_free(tr, d.t, d.t_commit, spec, obst, preds), d
+                # (an escape brakes at the end of its motion at the latest)
+                assert d.t_commit >= min(t_act, tr.t_end) - 1e-9, (d, t_act)
+                assert _escape_free(tr, d.t, t_act, spec, obst, preds), d
         else:
             assert d.kind in FALLBACK_KINDS
             assert fallbacks[n_fb]["t"] == d.t and fallbacks[n_fb]["kind"] == d.kind
@@ -218,6 +281,8 @@ def test_gap_walker_without_waiting_collides_unless_the_invariant_holds():
     good = simulate(sc, agent, seed=0)
     assert not (good.collision and good.collision_robot_caused)
     assert good.extra["fallbacks"]
+    # the run takes stoppable motions, so check_invariant checks their commit times
+    assert any(d.rule == "stoppable" for d in agent.guard.decisions)
     check_invariant(sc, agent, good)
 
 
