@@ -64,6 +64,14 @@ def test_noise_is_gaussian_with_the_stated_sigma_and_seeded():
     assert [(d.x, d.y) for d in b] != [tuple(m) for m in meas[:5]]
 
 
+def test_runs_without_a_sensor_model_record_only_their_mode():
+    # oracle and twist read no noise, rate or seed: a record of them would say they applied
+    for mode in ("oracle", "twist"):
+        sc = override_sensing(scenario_from_dict(small_scenario_dict()), mode)
+        res = simulate(sc, Recorder(), seed=3, config=SimConfig(time_limit=1.0))
+        assert res.extra["perception"] == {"mode": mode}
+
+
 def test_simulated_runs_record_the_noise_seed_and_repeat():
     sc = _tracked(static_obstacles=[])
     runs = []

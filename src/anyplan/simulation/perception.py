@@ -103,7 +103,10 @@ class Sensor:
         self.false_detections = 0
 
     def record(self) -> dict[str, object]:
-        """What to store in ``result.extra["perception"]``."""
+        """What to store in ``result.extra["perception"]``: the mode alone for ``oracle`` and
+        ``twist``, which read none of the sensor's other settings (nor draw noise)."""
+        if self.spec.mode != "tracked":
+            return {"mode": self.spec.mode}
         out: dict[str, object] = {
             "mode": self.spec.mode, "noise_m": self.spec.noise_m, "rate_hz": self.spec.rate_hz,
             "noise_seed": list(self.seed_sequence), "frames": self.frames,
