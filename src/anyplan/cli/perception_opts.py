@@ -77,13 +77,20 @@ def apply_perception(command: str, scenarios: Sequence[Scenario],
         opt = _FLAGS.get(getattr(exc, "field", ""), "--perception")
         raise UsageError(f"{command}: {opt}: {exc}") from None
     given = [_FLAGS[k] for k in TRACKED_ONLY if getattr(args, _DESTS[k]) is not None]
-    for scenario in out if given else ():
+    if given:
+        _only_tracked(command, given[0], "sensor", out)
+    return out
+
+
+def _only_tracked(command: str, flag: str, what: str, scenarios: Sequence[Scenario]) -> None:
+    """Refuse ``flag`` (``what`` settings) when one of ``scenarios`` does not perceive
+    ``tracked``: nothing would read them."""
+    for scenario in scenarios:
         mode = "oracle" if scenario.sensing is None else scenario.sensing.mode
         if mode != "tracked":
-            raise UsageError(f"{command}: {given[0]}: {scenario.name}'s perception is '{mode}'; "
-                             "sensor settings apply to tracked perception only "
+            raise UsageError(f"{command}: {flag}: {scenario.name}'s perception is '{mode}'; "
+                             f"{what} settings apply to tracked perception only "
                              "(--perception tracked)")
-    return out
 
 
 def add_tracker_option(p: argparse.ArgumentParser) -> None:
@@ -109,10 +116,6 @@ def tracker_settings(command: str, args: argparse.Namespace,
         out = parse_tracking_settings(args.tracker)
     except ValueError as exc:
         raise UsageError(f"{command}: --tracker: {exc}") from None
-    for scenario in scenarios if out else ():
-        mode = "oracle" if scenario.sensing is None else scenario.sensing.mode
-        if mode != "tracked":
-            raise UsageError(f"{command}: --tracker: {scenario.name}'s perception is '{mode}'; "
-                             "tracker settings apply to tracked perception only "
-                             "(--perception tracked)")
+    if out:
+        _only_tracked(command, "--tracker", "tracker", scenarios)
     return out
