@@ -70,24 +70,20 @@ def test_contact_instants():
     assert t == pytest.approx(1.4)
 
 
-class _Parked(Agent):
-    name = "parked"
+class _Straight(Agent):
+    """Commands one forward speed ``v`` [m/s] (0: parked) and no turn, whatever it sees."""
+
+    name = "straight-on"
+
+    def __init__(self, v: float) -> None:
+        super().__init__()
+        self.v = v
 
     def reset(self, scenario, rng):
         pass
 
     def act(self, obs):
-        return Command(0.0, 0.0)
-
-
-class _Forward(Agent):
-    name = "forward"
-
-    def reset(self, scenario, rng):
-        pass
-
-    def act(self, obs):
-        return Command(0.5, 0.0)
+        return Command(self.v, 0.0)
 
 
 def test_simulator_classifies_both_sides_of_a_collision():
@@ -96,7 +92,7 @@ def test_simulator_classifies_both_sides_of_a_collision():
                                                 "omega": 0.0, "radius": 0.3}])
     d["robot"]["start"] = [2.0, 3.0, 0.0]
     sc = scenario_from_dict(d)
-    res = simulate(sc, _Parked(), seed=0, config=SimConfig(time_limit=10.0))
+    res = simulate(sc, _Straight(0.0), seed=0, config=SimConfig(time_limit=10.0))
     assert res.collision and res.collision_with == "W"
     assert res.collision_robot_caused is False
     assert res.collision_approach_speed_mps == pytest.approx(0.0, abs=1e-12)
@@ -104,7 +100,7 @@ def test_simulator_classifies_both_sides_of_a_collision():
     d2 = small_scenario_dict(dynamic_obstacles=[])
     d2["robot"]["start"] = [4.0, 3.0, math.pi / 2]
     d2["robot"]["goal"] = [7.0, 1.0]
-    res2 = simulate(scenario_from_dict(d2), _Forward(), seed=0, config=SimConfig(time_limit=10.0))
+    res2 = simulate(scenario_from_dict(d2), _Straight(0.5), seed=0, config=SimConfig(time_limit=10.0))
     assert res2.collision and res2.collision_with == "S1"
     assert res2.collision_robot_caused is True
     assert res2.collision_approach_speed_mps > 0.05
@@ -114,19 +110,9 @@ def test_simulator_classifies_both_sides_of_a_collision():
 
 def test_no_collision_gives_none():
     d = small_scenario_dict(dynamic_obstacles=[])
-    res = simulate(scenario_from_dict(d), _Parked(), seed=0, config=SimConfig(time_limit=1.0))
+    res = simulate(scenario_from_dict(d), _Straight(0.0), seed=0, config=SimConfig(time_limit=1.0))
     assert not res.collision and res.collision_robot_caused is None
     assert res.collision_approach_speed_mps is None
-
-
-class _Dash(Agent):
-    name = "dash"
-
-    def reset(self, scenario, rng):
-        pass
-
-    def act(self, obs):
-        return Command(1.0, 0.0)
 
 
 def test_the_contact_is_classified_at_the_contact_instant_not_at_the_steps_start():
@@ -150,7 +136,7 @@ def test_the_contact_is_classified_at_the_contact_instant_not_at_the_steps_start
         static_obstacles=[],
         dynamic_obstacles=[{"name": "D", "type": "waypoints", "radius": 0.05,
                             "keyframes": [[0.0, *q0], [1.0, *(q0 + w)]]}])
-    res = simulate(scenario_from_dict(d), _Dash(), seed=0, config=SimConfig(dt=dt, time_limit=0.5))
+    res = simulate(scenario_from_dict(d), _Straight(1.0), seed=0, config=SimConfig(dt=dt, time_limit=0.5))
     assert res.collision and res.collision_with == "D"
     assert res.collision_time_s - dt <= t_c <= res.collision_time_s
     assert res.collision_time_s == pytest.approx(0.25)
