@@ -239,13 +239,12 @@ def _png_size(path: str | Path) -> tuple[int, int]:
 
 
 def _read_png(opened: Any) -> tuple[np.ndarray, np.ndarray | None]:
-    """:func:`read_image` of an opened Pillow image (closed on return)."""
+    """:func:`read_image` of an opened Pillow image (closed on return; its size was checked
+    from the file's header)."""
     from PIL import Image
 
     with opened:
         im: Image.Image = opened
-        if im.width * im.height > MAX_CELLS:
-            raise ValueError(f"image {im.width} x {im.height} has more than {MAX_CELLS} pixels")
         mode = im.mode
         if mode == "P" or mode == "PA":
             im = im.convert("RGBA")
