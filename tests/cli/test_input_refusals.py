@@ -54,9 +54,18 @@ def test_bench_config_values_are_checked_as_set_checks_them(tmp_path, scenario, 
     assert not (tmp_path / "b.db").exists()  # refused before any run
 
 
-def test_a_good_bench_config_is_recorded_as_given_or_converted_as_set_converts(tmp_path, scenario):
+def test_a_bad_bench_config_is_refused_before_the_suite_is_read(tmp_path, capsys):
+    argv = _bench(tmp_path / "missing.yaml", tmp_path, "--config", 'straight={"nope": 1}')
+    assert main(argv) == 2
+    _one_line(capsys, "--config straight: unknown setting")
+
+
+def test_a_good_bench_config_is_recorded_as_given_or_converted_as_set_converts(tmp_path, scenario,
+                                                                               capsys):
     assert main(_bench(scenario, tmp_path, "--config", 'straight={"align_tolerance": 3}')) == 0
+    capsys.readouterr()
     assert main(_bench(scenario, tmp_path, "--config", 'straight={"heading_gain": "1.5"}')) == 0
+    assert "1 runs in" in capsys.readouterr().out  # the bench's tables find its converted run
     with ResultsDB(tmp_path / "b.db", readonly=True) as db:
         runs = db.runs()
     # an int stays an int (the settings string of earlier runs), the string became a number

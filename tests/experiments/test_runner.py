@@ -133,3 +133,19 @@ def test_unknown_planner_is_a_clear_error(tiny_file):
 
     with pytest.raises(UnknownNameError, match="unknown planner 'strait'"):
         plan_tasks([load_scenario(tiny_file)], [PlannerSpec("strait")], 1, 0)
+
+
+def test_a_library_config_is_checked_as_bench_config_is(tmp_path, tiny_file):
+    sc = load_scenario(tiny_file)
+    with pytest.raises(BenchError, match=r"^config straight: heading_gain='x': planner 'straight' "
+                                         "expects float"):
+        plan_tasks([sc], [PlannerSpec("straight", {"heading_gain": "x"})], 1, 0)
+    with pytest.raises(BenchError, match=r"^config straight: unknown setting of planner 'straight' 'nope'"):
+        run_bench([sc], [PlannerSpec("straight", {"nope": 1})], 1, tmp_path / "r.db", progress=False)
+    assert not (tmp_path / "r.db").exists()  # refused before the database is opened
+    # a value the check converts runs converted and is recorded so; any other is kept as given
+    run_bench([sc], [PlannerSpec("straight", {"heading_gain": "1.5", "align_tolerance": 3})], 1,
+              tmp_path / "r.db", progress=False)
+    with ResultsDB(tmp_path / "r.db", readonly=True) as db:
+        (r,) = db.runs()
+    assert r["settings"] == "align_tolerance = 3;heading_gain = 1.5;" and r["error"] is None

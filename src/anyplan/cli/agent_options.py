@@ -9,7 +9,7 @@ from typing import Any
 from anyplan.agents.base import AGENTS
 from anyplan.agents.settings import SettingsError, agent_settings, build_agent_config, parse_set_options
 
-__all__ = ["add_agent_options", "run_config", "bench_configs", "check_config_options"]
+__all__ = ["add_agent_options", "run_config", "bench_configs"]
 
 SET_HELP = ("agent setting, e.g. --set planning_delay=0.1 (repeatable; VALUE is read as YAML: "
             "0.1, 2, true, null, measured; 'anyplan planners --settings' lists the keys)")
@@ -35,39 +35,12 @@ def run_config(args: argparse.Namespace, planner: str) -> dict[str, Any]:
     return build_agent_config(cls, planner, parse_set_options(args.set_options), args.deterministic)
 
 
-def check_config_options(configs: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
-    """``bench --config NAME=JSON`` configs (planner name -> keywords), checked as ``--set``
-    checks its settings (:func:`~anyplan.agents.settings.build_agent_config`: known keys, their
-    types, the agent's own checks) before any run starts. A value is kept as given unless the
-    check converted it into another one (the string ``"0.5"`` of a float setting becomes 0.5),
-    so the recorded settings of a good config are unchanged.
-
-    Raises:
-        SettingsError: about ``config`` (the command line's ``--config``), naming the planner.
-    """
-    out = {}
-    for name, given in configs.items():
-        try:
-            checked = build_agent_config(AGENTS.get(name), name, dict(given)) if given else {}
-        except SettingsError as exc:
-            raise SettingsError.about("config", f" {name}: {exc.rest.lstrip(': ')}") from None
-        out[name] = {k: v if _same(v, checked[k]) else checked[k] for k, v in given.items()}
-    return out
-
-
-def _same(given: Any, checked: Any) -> bool:
-    """Whether the checked value is the given one (``1`` and ``1.0``, ``[1, 2]`` and
-    ``(1.0, 2.0)`` are; the string ``"1"`` and ``1.0`` are not)."""
-    if isinstance(given, list | tuple) and isinstance(checked, list | tuple):
-        return len(given) == len(checked) and all(map(_same, given, checked))
-    return isinstance(given, str) == isinstance(checked, str) and bool(given == checked)
-
-
 def bench_configs(args: argparse.Namespace, planners: Sequence[str],
                   base: dict[str, dict[str, Any]] | None = None,
                   source: str = "--planners") -> dict[str, dict[str, Any]]:
     """Per-planner keyword configs from ``--set [PLANNER:]KEY=VALUE`` and ``--deterministic``,
-    on top of ``base`` (e.g. ``--config``, checked by :func:`check_config_options`);
+    on top of ``base`` (e.g. ``--config``, checked by
+    :func:`~anyplan.experiments.runner.check_planner_config`);
     ``source`` names where the planners come from in the error messages (a benchmark with a
     fixed list has no ``--planners``)."""
     base = base or {}

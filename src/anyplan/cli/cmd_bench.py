@@ -152,7 +152,13 @@ def _usage(msg: str) -> Exception:
 def cmd_bench(args: argparse.Namespace) -> int:
     """Run the bench, then print and write the tables."""
     from anyplan.experiments.db import ResultsDB, agent_settings_string
-    from anyplan.experiments.runner import BenchInterrupted, parse_planners, run_bench
+    from anyplan.experiments.runner import (
+        BenchInterrupted,
+        PlannerSpec,
+        check_planner_config,
+        parse_planners,
+        run_bench,
+    )
     from anyplan.experiments.suites import resolve_suite, suite_size
     from anyplan.experiments.tables import (
         compare_planners,
@@ -172,13 +178,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
         raise _usage(f"bench: --jobs must be >= 1, got {args.jobs}")
     if args.jobs > checks.MAX_JOBS:
         raise _usage(f"bench: --jobs must be <= {checks.MAX_JOBS} (the stated limit), got {args.jobs}")
-    planners = parse_planners(default_bench_planners() if args.planners is None else args.planners,
-                              args.config)
-    from anyplan.cli.agent_options import check_config_options
-    from anyplan.experiments.runner import PlannerSpec
-
-    given = check_config_options({p.name: dict(p.config) for p in planners})
-    planners = [PlannerSpec(p.name, given[p.name]) for p in planners]
+    # --config is checked here, before the suite is made; its checked values are what --set adds to
+    planners = [check_planner_config(p) for p in parse_planners(
+        default_bench_planners() if args.planners is None else args.planners, args.config)]
     if args.set_options or args.deterministic:
         from anyplan.cli.agent_options import bench_configs
 

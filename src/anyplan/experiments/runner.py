@@ -29,6 +29,7 @@ from typing import Any, TextIO
 import numpy as np
 
 from anyplan.agents.base import AGENTS, make_agent
+from anyplan.agents.settings import SettingsError, build_agent_config
 from anyplan.errors import AnyplanError
 from anyplan.experiments.db import ExperimentKey, ResultsDB, agent_settings_string, run_row, settings_string
 from anyplan.experiments.progress import ProgressBar
@@ -36,7 +37,7 @@ from anyplan.simulation.simulator import SimConfig, simulate
 from anyplan.world.scenario import Scenario
 
 __all__ = ["PlannerSpec", "RunTask", "BenchError", "BenchInterrupted", "BenchSummary", "derive_seed",
-           "execute_task", "plan_tasks", "run_bench", "parse_planners"]
+           "execute_task", "plan_tasks", "run_bench", "parse_planners", "check_planner_config"]
 
 log = logging.getLogger(__name__)
 
@@ -94,18 +95,32 @@ def parse_planners(text: str, configs: Sequence[str] = ()) -> list[PlannerSpec]:
     return [PlannerSpec(n, cfg.get(n, {})) for n in names]
 
 
-def check_planner_config(spec: PlannerSpec) -> None:
-    """Instantiate the planner once with its config, so a bad keyword fails before the bench.
+def check_planner_config(spec: PlannerSpec) -> PlannerSpec:
+    """``spec`` with its config checked as ``--set`` checks agent settings
+    (:func:`~anyplan.agents.settings.build_agent_config`: known keys, their types, the agent's
+    own checks), so a bad config fails before the bench. A value is kept as given unless the
+    check converted it into another one (the string ``"0.5"`` of a float setting becomes 0.5),
+    so the recorded settings of a good config are unchanged.
 
     Raises:
-        BenchError: the agent rejects its config.
+        BenchError: about ``config``, naming the planner.
     """
     if not spec.config:
-        return
+        return spec
     try:
-        make_agent(spec.name, **spec.config)
-    except (TypeError, ValueError) as exc:
-        raise BenchError.about("config", f" {spec.name}: {exc}") from None
+        checked = build_agent_config(AGENTS.get(spec.name), spec.name, dict(spec.config))
+    except SettingsError as exc:
+        raise BenchError.about("config", f" {spec.name}: {exc.rest.lstrip(': ')}") from None
+    return PlannerSpec(spec.name, {k: v if _same(v, checked[k]) else checked[k]
+                                   for k, v in spec.config.items()})
+
+
+def _same(given: Any, checked: Any) -> bool:
+    """Whether the checked value is the given one (``1`` and ``1.0``, ``[1, 2]`` and
+    ``(1.0, 2.0)`` are; the string ``"1"`` and ``1.0`` are not)."""
+    if isinstance(given, list | tuple) and isinstance(checked, list | tuple):
+        return len(given) == len(checked) and all(map(_same, given, checked))
+    return isinstance(given, str) == isinstance(checked, str) and bool(given == checked)
 
 
 def derive_seed(master_seed: int, run_index: int) -> int:
@@ -178,19 +193,19 @@ def _planner_entry(name: str) -> str | None:
 def plan_tasks(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], runs: int,
                master_seed: int, dt: float = 0.05, time_limit: float | None = None,
                sim: SimConfig | None = None) -> list[RunTask]:
-    """All tasks, ordered run-major so that partial results cover every planner and scenario;
-    ``sim`` (if given) replaces ``dt`` and ``time_limit``."""
+    """All tasks, ordered run-major so that partial results cover every planner and scenario,
+    each with its planner's config checked (:func:`check_planner_config`); ``sim`` (if given)
+    replaces ``dt`` and ``time_limit``."""
     if runs < 1:
         raise BenchError.about("runs", f" must be >= 1, got {runs}")
     sim = sim if sim is not None else _sim_config(dt, time_limit)
     entries = {p.name: _planner_entry(p.name) for p in planners}
-    for p in planners:
-        check_planner_config(p)
+    checked = [check_planner_config(p) for p in planners]
     tasks = []
     for i in range(runs):
         seed = derive_seed(master_seed, i)
         for sc in scenarios:
-            for p in planners:
+            for p in checked:
                 tasks.append(RunTask(sc, sc.name, sc.content_hash(), p.name, dict(p.config),
                                      entries[p.name], i, seed, sim))
     return tasks
@@ -328,8 +343,10 @@ def run_bench(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], ru
                                           suite=suite)
         # the tracker's settings, the execution and localization errors (the same for every task) are part of
         # each planner's row
-        plan_ids = {(p.name, settings_string(p.config)): db.planner_id(
-            p.name, agent_settings_string(p.config, sim)) for p in planners}
+        # the tasks' configs are the checked ones (a value the check converted, converted)
+        configs = {(t.planner, settings_string(t.planner_config)): t.planner_config for t in all_tasks}
+        plan_ids = {key: db.planner_id(key[0], agent_settings_string(cfg, sim))
+                    for key, cfg in configs.items()}
         done = db.done_keys()
         tasks = []
         for t in all_tasks:
