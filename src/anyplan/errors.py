@@ -81,12 +81,15 @@ class ScenarioError(AnyplanError, ValueError):
     Attributes:
         source: The file (or "<dict>") the scenario came from.
         field: Dotted path of the offending field, e.g. ``robot.radius``.
+        obstacle: The name of the static obstacle the field's value runs into (a start inside
+            one), or None.
     """
 
-    def __init__(self, source: str, field: str, message: str) -> None:
+    def __init__(self, source: str, field: str, message: str, obstacle: str | None = None) -> None:
         self.source = source
         self.field = field
         self.message = message
+        self.obstacle = obstacle
         where = f"{source}: {field}" if field else source
         super().__init__(f"{where}: {message}")
 

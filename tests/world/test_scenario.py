@@ -94,6 +94,15 @@ def test_bad_input_names_the_field(mutate, field, words):
     assert "\n" not in str(e)
 
 
+def test_a_start_or_goal_inside_an_obstacle_names_the_obstacle():
+    d = copy.deepcopy(small_scenario_dict())
+    d["robot"]["start"] = [4.0, 5.0, 0.0]
+    e = _err(d)
+    assert (e.field, e.obstacle) == ("robot.start", "S1")
+    d["robot"]["start"] = [9.0, 5.0, 0.0]
+    assert _err(d).obstacle is None  # outside the arena: about no obstacle
+
+
 def test_malformed_yaml_and_missing_file(tmp_path):
     f = tmp_path / "bad.yaml"
     f.write_text("name: x\narena: {width: 15, height: [\n")

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -134,9 +133,10 @@ def world_to_scenario(world: Mapping[str, Any], profile: Mapping[str, float] | N
     """
     prof = dict(JACKAL if profile is None else profile)
     idx = int(world["world"])
-    statics = [{"name": f"c{k}", "type": "circle",
+    names = [f"c{k}" for k in range(len(world["cylinders"]))]
+    statics = [{"name": n, "type": "circle",
                 "center": [float(c[0]) + SHIFT[0], float(c[1]) + SHIFT[1]], "radius": float(c[2])}
-               for k, c in enumerate(world["cylinders"])]
+               for n, c in zip(names, world["cylinders"], strict=True)]
     sx, sy, th = START
     data = {
         "name": name or scenario_name(idx),
@@ -153,18 +153,17 @@ def world_to_scenario(world: Mapping[str, Any], profile: Mapping[str, float] | N
     try:
         scenario_from_dict(data, f"<barn world {idx}>")  # validate (start/goal free, schema)
     except AnyplanError as exc:
-        raise _converted_error(exc, where, world, float(prof["radius"])) from None
+        raise _converted_error(exc, where, world, float(prof["radius"]), names) from None
     return data
 
 
 def _converted_error(exc: AnyplanError, where: str, world: Mapping[str, Any],
-                     radius: float) -> AnyplanError:
-    """A scenario error told in the worlds file's terms: a cylinder on the start or goal as
-    ``world N.cylinders[K]``, in BARN's frame."""
-    m = re.search(r"inside static obstacle c(\d+) ", exc.message) if isinstance(exc, ScenarioError) \
-        else None
-    if m and isinstance(exc, ScenarioError) and exc.field in ("robot.start", "robot.goal"):
-        k = int(m.group(1))
+                     radius: float, names: list[str]) -> AnyplanError:
+    """A scenario error told in the worlds file's terms: a cylinder (the obstacle named
+    ``names[K]``) on the start or goal as ``world N.cylinders[K]``, in BARN's frame."""
+    if isinstance(exc, ScenarioError) and exc.obstacle in names \
+            and exc.field in ("robot.start", "robot.goal"):
+        k = names.index(exc.obstacle)
         x, y, r = (float(v) for v in world["cylinders"][k])
         which, (px, py) = ("start", START[:2]) if exc.field == "robot.start" else ("goal", GOAL)
         return BARNError(f"{where}.cylinders[{k}]: ({x:g}, {y:g}) r {r:g} is within the robot "

@@ -306,7 +306,7 @@ def _check_task(c: Ctx, sc: Scenario) -> None:
                 raise c.fail(fld, f"({x:g}, {y:g}) is within the robot radius {r:g} of an "
                                   f"occupied or unknown cell of the map {sc.static_map.source}")
             raise c.fail(fld, f"({x:g}, {y:g}) is inside static obstacle {hit} inflated by the "
-                              f"robot radius {r:g}")
+                              f"robot radius {r:g}", obstacle=hit)
 
 
 def _static_map(c: Ctx, obj: Any) -> OccupancyMap | None:

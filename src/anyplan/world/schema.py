@@ -62,8 +62,8 @@ class Ctx:
     def __init__(self, source: str) -> None:
         self.source = source
 
-    def fail(self, fld: str, msg: str) -> ScenarioError:
-        return ScenarioError(self.source, fld, msg)
+    def fail(self, fld: str, msg: str, obstacle: str | None = None) -> ScenarioError:
+        return ScenarioError(self.source, fld, msg, obstacle)
 
     def mapping(self, obj: Any, fld: str) -> Mapping[str, Any]:
         if not isinstance(obj, Mapping):
