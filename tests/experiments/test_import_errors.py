@@ -268,6 +268,16 @@ def test_dynabarn_world_to_scenario_names_the_source(tmp_path):
         dynabarn.world_to_scenario(_moving({"radius": -1}), source="w.json")
 
 
+@pytest.mark.parametrize(("index", "words"), [
+    ("x", "world entry.world: expected an integer index, got 'x'"),
+    (-3, "world entry.world: must be in [0, 999] (the stated limit), got -3"),
+])
+def test_dynabarn_world_to_scenario_checks_the_index_as_load_worlds_does(index, words):
+    with pytest.raises(dynabarn.DynaBARNError, match=r"^w\.json: ") as ei:
+        dynabarn.world_to_scenario({**DYN_WORLD, "world": index}, source="w.json")
+    assert words in str(ei.value)
+
+
 def test_dynabarn_unknown_keys_of_unconverted_worlds_are_refused_too(tmp_path, capsys):
     _dyn(capsys, tmp_path, [{**DYN_WORLD, "world": 0}, {**DYN_WORLD, "world": 1, "colour": 1}],
          "world 1: unknown key 'colour'")

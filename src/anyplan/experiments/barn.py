@@ -68,7 +68,7 @@ _WORLD_KEYS = ("world", "cylinders", "reference_path_length_m")
 
 
 def _check_world(w: Any, k: int, src: str) -> None:
-    idx = dynabarn.world_index(w, k, src, BARNError)
+    idx = dynabarn.world_index(w, f"{src}: [{k}]", BARNError)
     where = f"{src}: world {idx}"
     dynabarn.check_keys(w, _WORLD_KEYS, where, BARNError)
     _num(w.get("reference_path_length_m"), f"{where}.reference_path_length_m", positive=True)

@@ -77,7 +77,7 @@ def load_worlds(path: str | Path) -> list[dict[str, Any]]:
         raise DynaBARNError(f"{p}: expected a non-empty JSON list of worlds")
     seen: dict[int, int] = {}
     for k, w in enumerate(data):
-        idx = world_index(w, k, str(p), DynaBARNError)
+        idx = world_index(w, f"{p}: [{k}]", DynaBARNError)
         check_keys(w, _WORLD_KEYS, f"{p}: world {idx}", DynaBARNError)
         if idx in seen:
             raise DynaBARNError(f"{p}: world {idx} appears twice ([{seen[idx]}] and [{k}])")
@@ -91,10 +91,9 @@ _WALL_KEYS = ("name", "pose", "size")
 _MOVING_KEYS = ("name", "radius", "period", "keyframes")
 
 
-def world_index(w: Any, k: int, src: str, error: type[AnyplanError]) -> int:
-    """The ``world`` index of item ``k`` of worlds file ``src``: an integer in
-    [0, MAX_IMPORT_SCENARIOS - 1]."""
-    where = f"{src}: [{k}]"
+def world_index(w: Any, where: str, error: type[AnyplanError]) -> int:
+    """The ``world`` index of the world ``w`` (``where`` names it, e.g. ``FILE: [3]`` for item
+    3 of a worlds file): an integer in [0, MAX_IMPORT_SCENARIOS - 1]."""
     if not isinstance(w, Mapping):
         raise error(f"{where}: expected a world object, got {shorten(w)}")
     if "world" not in w:
@@ -205,9 +204,7 @@ def world_to_scenario(world: Mapping[str, Any], profile: Mapping[str, float] | N
     """
     prof = dict(JACKAL if profile is None else profile)
     pre = f"{source}: " if source is not None else ""
-    idx = world.get("world")
-    if isinstance(idx, bool) or not isinstance(idx, int):
-        raise DynaBARNError(f"{pre}world entry: 'world' must be an integer index, got {shorten(idx)}")
+    idx = world_index(world, f"{pre}world entry", DynaBARNError)
     where = f"{pre}world {idx}"
     check_keys(world, _WORLD_KEYS, where, DynaBARNError)
     walls = world.get("walls")
