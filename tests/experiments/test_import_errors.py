@@ -118,6 +118,13 @@ def test_copy_shift_must_be_finite_and_positive(tmp_path, capsys, shift):
         CrowdOptions(copies=2, copy_shift_s=float(shift)).check()
 
 
+def test_bad_options_are_refused_when_made_before_any_file_is_read(tmp_path, capsys):
+    with pytest.raises(CrowdError, match=r"^noise_m must be a finite number >= 0, got -1"):
+        CrowdOptions(noise_m=-1.0)
+    _refused(capsys, ["import-crowd", str(tmp_path / "missing.txt"), "--out", str(tmp_path / "o"),
+                      "--sensor-noise", "-1"], "--sensor-noise must be a finite number >= 0")
+
+
 def test_copies_that_coincide_are_refused(tmp_path, capsys):
     # The recording lasts 31.6 s, so T = 32 s: copy 2 shifted by 2 x 16 s lies on copy 0.
     _refused(capsys, ["import-crowd", str(_small(tmp_path)), "--out", str(tmp_path / "o"), "--copies",

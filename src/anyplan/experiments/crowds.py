@@ -57,7 +57,7 @@ class CrowdError(AnyplanError):
 
 @dataclass(frozen=True)
 class CrowdOptions:
-    """Import settings (lengths in m, times in s)."""
+    """Import settings (lengths in m, times in s), checked when made (:meth:`check`)."""
 
     window_s: float = 40.0
     step_s: float = 40.0
@@ -69,6 +69,9 @@ class CrowdOptions:
     noise_m: float = 0.05
     rate_hz: float = 10.0
     robot: Mapping[str, float] | None = None
+
+    def __post_init__(self) -> None:
+        self.check()
 
     def check(self) -> None:
         """Raises CrowdError on an out-of-range option (each checked against its stated limit)."""
@@ -226,11 +229,12 @@ def crowd_scenarios(tracks: Mapping[int, np.ndarray], name: str,
     """Scenario dictionaries (our YAML schema), one per usable window of the recording.
 
     Raises:
-        CrowdError: a bad option, or a recording or window beyond a stated limit, naming
-            ``source`` (the obsmat file; default ``name``).
+        CrowdError: options the recording cannot use (more windows than the limit, copies
+            that coincide) or a recording or window beyond a stated limit, naming ``source``
+            (the obsmat file; default ``name``). An option out of its range is refused when
+            the :class:`CrowdOptions` is made.
     """
     opt = options or CrowdOptions()
-    opt.check()
     src = source or name
     robot = {**SERVICE_ROBOT, **(opt.robot or {})}
     r = robot["radius"]
@@ -370,7 +374,6 @@ def import_crowd(path: str | Path, out_dir: str | Path, options: CrowdOptions | 
     if name is not None:
         _check_name(name)
     opt = options or CrowdOptions()
-    opt.check()
     tracks = read_obsmat(p)
     base = name or p.stem.replace("_obsmat", "").replace("_", "-")
     scenarios = crowd_scenarios(tracks, base, opt, source=str(p))
