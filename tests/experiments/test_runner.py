@@ -135,6 +135,22 @@ def test_unknown_planner_is_a_clear_error(tiny_file):
         plan_tasks([load_scenario(tiny_file)], [PlannerSpec("strait")], 1, 0)
 
 
+def test_a_registered_object_that_is_not_an_agent_class_is_refused_before_any_run(tmp_path, tiny_file):
+    from anyplan.agents.base import AGENTS
+
+    AGENTS.register("not-an-agent", "json:JSONDecoder", origin="plugin from x 1")
+    try:
+        for config in ({}, {"strict": True}):  # with a config or without, as make_agent refuses it
+            with pytest.raises(BenchError, match=r"^planner 'not-an-agent' \(plugin from x 1\) is not "
+                                                 r"an anyplan.agents.Agent subclass"):
+                run_bench([load_scenario(tiny_file)], [PlannerSpec("not-an-agent", config)], 1,
+                          tmp_path / "r.db", progress=False)
+        assert not (tmp_path / "r.db").exists()  # refused before the database is opened
+    finally:
+        AGENTS._entries.pop("not-an-agent")
+        AGENTS._origins.pop("not-an-agent")
+
+
 def test_a_library_config_is_checked_as_bench_config_is(tmp_path, tiny_file):
     sc = load_scenario(tiny_file)
     with pytest.raises(BenchError, match=r"^config straight: heading_gain='x': planner 'straight' "

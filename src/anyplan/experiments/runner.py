@@ -28,7 +28,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from anyplan.agents.base import AGENTS, make_agent
+from anyplan.agents.base import AGENTS, Agent, make_agent
 from anyplan.agents.settings import SettingsError, build_agent_config
 from anyplan.errors import AnyplanError
 from anyplan.experiments.db import ExperimentKey, ResultsDB, agent_settings_string, run_row, settings_string
@@ -103,8 +103,10 @@ def check_planner_config(spec: PlannerSpec) -> PlannerSpec:
     so the recorded settings of a good config are unchanged.
 
     Raises:
-        BenchError: about ``config``, naming the planner.
+        BenchError: about ``config``, naming the planner; or the planner is not an agent
+            class (:func:`_planner_entry`).
     """
+    _planner_entry(spec.name)
     if not spec.config:
         return spec
     try:
@@ -179,11 +181,19 @@ def execute_task(task: RunTask) -> dict[str, Any]:
 
 
 def _planner_entry(name: str) -> str | None:
-    """``module:qualname`` of a registered agent class, for registration inside workers."""
+    """``module:qualname`` of a registered agent class, for registration inside workers.
+
+    Raises:
+        BenchError: the planner cannot be imported, or is not an :class:`Agent` class.
+    """
     try:
         cls = AGENTS.get(name)
     except ImportError as exc:
         raise BenchError(f"planner '{name}' is registered but cannot be imported ({exc})") from None
+    if not (isinstance(cls, type) and issubclass(cls, Agent)):
+        # refused before any run, as make_agent would refuse it in every one
+        raise BenchError(f"planner '{name}' ({AGENTS.origin(name)}) is not an anyplan.agents.Agent "
+                         f"subclass: {cls!r}")
     mod, qual = getattr(cls, "__module__", None), getattr(cls, "__qualname__", None)
     if not mod or not qual or "<locals>" in qual:
         return None
