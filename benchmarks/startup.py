@@ -1,7 +1,7 @@
 """Benchmark: the README's first command's start, on a cold and on a warm numba cache (issue 11).
 
-Runs ``anyplan run paper-3 --out DIR`` (what ``anyplan`` runs; the default planner seq-bitstar)
-in fresh processes:
+Runs ``anyplan run paper-3 --out DIR --no-plot`` (the README's first command; the default
+planner, st-bitstar) in fresh processes:
 
 * cold: with an empty ``NUMBA_CACHE_DIR`` (a fresh machine): the seconds numba compiles (wall
   and CPU, from numba's ``numba:compile`` events, nested compilations counted once), split by
