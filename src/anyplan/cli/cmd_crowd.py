@@ -40,9 +40,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help=f"tracked sensing noise [m] (default {d.noise_m:g})")
     p.add_argument("--sensor-rate", type=float, default=d.rate_hz, metavar="HZ",
                    help=f"tracked sensing rate [Hz] (default {d.rate_hz:g})")
+    units = {"radius": "m", "v_max": "m/s", "omega_max": "rad/s", "a_max": "m/s^2",
+             "alpha_max": "rad/s^2", "goal_tolerance": "m"}
     for key, val in SERVICE_ROBOT.items():
         p.add_argument(f"--robot-{key.replace('_', '-')}", type=float, default=val, dest=f"robot_{key}",
-                       help=f"robot {key} (default {val:g})")
+                       help=f"robot {key}" + (f" [{units[key]}]" if key in units else "")
+                       + f" (default {val:g})")
     p.set_defaults(func=cmd_import_crowd)
 
 
