@@ -13,6 +13,7 @@ import pytest
 import yaml
 from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "experiments"))
 
@@ -169,7 +170,10 @@ def test_report_figures(tmp_path, saved, five_scenario_db):
     titles = sorted(ax.get_title() for ax in fig.axes if ax.get_title())
     assert titles == sorted([f"tiny-{k}" for k in range(5)] + ["crowd-26"])
     assert all(ax.get_lines() for ax in fig.axes if ax.get_title())
-    assert "OMPL" not in fig.get_suptitle()
+    # (found among the figure's texts: Figure.get_suptitle is matplotlib >= 3.8, the floor 3.7)
+    title = [t.get_text() for t in fig.findobj(Text)
+             if t.get_text().startswith(("Best solution cost", "No anytime progress"))]
+    assert len(title) == 1 and "OMPL" not in title[0]
 
 
 def test_planner_and_dovs_figures(tmp_path, saved):
