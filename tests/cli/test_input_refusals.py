@@ -1,6 +1,6 @@
 """Bad input of ``run``, ``plan`` and ``bench`` refused before any work, with exit code 2 and one
-line naming the flag: ``--config`` values of the wrong type, empty arguments, sensor options
-that nothing reads, and a bench too large for its stated limit."""
+line naming the flag: ``--config`` values of the wrong type, empty arguments, sensor and other
+options that nothing reads, and a bench too large for its stated limit."""
 
 from __future__ import annotations
 
@@ -140,6 +140,31 @@ def test_a_tracked_scenario_run_as_oracle_takes_no_sensor_options(tmp_path, caps
     assert main([*argv, "--out", str(tmp_path / "c"), "--perception", "oracle",
                  "--sensor-noise", "0.1"]) == 2
     _one_line(capsys, "run: --sensor-noise: t's perception is 'oracle'")
+
+
+@pytest.mark.parametrize(("extra", "words"), [
+    (["--speed", "8"], "run: --speed applies to --animate only"),
+    (["--no-plot", "--speed", "8"], "run: --speed applies to --animate only"),
+    (["--no-plot", "--format", "svg"], "run: --format applies to the picture, which --no-plot turns off"),
+    (["--no-plot", "--format", "png"], "run: --format applies to the picture, which --no-plot turns off"),
+])
+def test_run_options_that_nothing_reads_are_refused(tmp_path, scenario, capsys, extra, words):
+    out = tmp_path / "r"
+    argv = ["run", str(scenario), "--planner", "straight", "--out", str(out), "--time-limit", "1"]
+    assert main([*argv, *extra]) == 2
+    _one_line(capsys, words)
+    assert not out.exists()  # refused before the run
+
+
+def test_run_speed_and_format_where_they_apply(tmp_path, scenario, capsys):
+    argv = ["run", str(scenario), "--planner", "straight", "--time-limit", "1"]
+    assert main([*argv, "--out", str(tmp_path / "a"), "--format", "svg"]) == 1  # a time-out
+    assert (tmp_path / "a" / "run.svg").exists() and not (tmp_path / "a" / "run.png").exists()
+    assert main([*argv, "--out", str(tmp_path / "b")]) == 1  # the default: a PNG
+    assert (tmp_path / "b" / "run.png").exists()
+    assert main([*argv, "--out", str(tmp_path / "c"), "--no-plot", "--animate", str(tmp_path / "c.gif"),
+                 "--speed", "8"]) == 1
+    assert (tmp_path / "c.gif").exists() and not list((tmp_path / "c").glob("run.*"))
 
 
 @pytest.mark.parametrize(("suite", "count", "runs", "planners", "scenarios"), [

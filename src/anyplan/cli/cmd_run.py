@@ -23,6 +23,9 @@ from anyplan.simulation.simulator import SimConfig, simulate
 from anyplan.world.scenario import builtin_scenarios, load_scenario
 
 DEFAULT_PLANNER = "st-bitstar"
+#: The picture format and the animation's playback speed when --format and --speed are not given.
+DEFAULT_FORMAT = "png"
+DEFAULT_SPEED = 4.0
 
 EXIT_CODES = """\
 exit codes:
@@ -57,12 +60,14 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "error of these spreads [m per axis, rad], and places what it senses with it "
                    "(seeded by --seed; default 0,0: exactly)")
     p.add_argument("--no-plot", action="store_true", help="do not write run.png")
-    p.add_argument("--format", default="png", choices=("png", "svg", "pdf"),
-                   help="picture format: DIR/run.png, run.svg or run.pdf (default png)")
+    p.add_argument("--format", default=None, choices=("png", "svg", "pdf"),
+                   help=f"picture format: DIR/run.png, run.svg or run.pdf (default {DEFAULT_FORMAT}; "
+                        "not with --no-plot)")
     p.add_argument("--animate", default=None, metavar="FILE", type=checks.nonempty("a file"),
                    help="also write an animation of the run (.gif, or .mp4 when ffmpeg is present)")
-    p.add_argument("--speed", type=checks.playback_speed, default=4.0,
-                   help="animation playback speed, x real time (default 4)")
+    p.add_argument("--speed", type=checks.playback_speed, default=None,
+                   help="with --animate: the animation's playback speed, x real time "
+                        f"(default {DEFAULT_SPEED:g})")
     add_perception_options(p)
     add_tracker_option(p)
     p.add_argument("--mcap", default=None, metavar="FILE", type=checks.nonempty("a file"),
@@ -124,7 +129,19 @@ def _compiling_notice() -> None:
     sys.stderr.flush()
 
 
+def _refuse_unused(args: argparse.Namespace) -> None:
+    """Refuse an option that nothing would read: ``--speed`` without ``--animate``, ``--format``
+    with ``--no-plot``."""
+    if args.speed is not None and not args.animate:
+        raise UsageError("run: --speed applies to --animate only")
+    if args.format is not None and args.no_plot:
+        raise UsageError("run: --format applies to the picture, which --no-plot turns off")
+
+
 def _run(args: argparse.Namespace) -> int:
+    _refuse_unused(args)  # before any work
+    fmt = args.format or DEFAULT_FORMAT
+    speed = DEFAULT_SPEED if args.speed is None else args.speed
     scenario = apply_perception("run", [load_scenario(args.scenario)], args)[0]
     config = run_config(args, args.planner)  # unknown names and bad settings fail before any work
     tracker = tracker_settings("run", args, [scenario])
@@ -143,13 +160,13 @@ def _run(args: argparse.Namespace) -> int:
     checks.writable_folder(out, "run: --out")
     checks.writable_file(out / "result.json", "run: --out")
     if not args.no_plot:
-        checks.writable_file(out / f"run.{args.format}", "run: --out")
+        checks.writable_file(out / f"run.{fmt}", "run: --out")
     if args.animate:
         from anyplan.viz.animation import check_target
 
         checks.writable_file(args.animate, "run: --animate", (".gif", ".mp4"))
         try:
-            check_target(args.animate, args.speed)
+            check_target(args.animate, speed)
         except ValueError as exc:
             raise UsageError(f"run: --animate: {exc}") from None
     if args.mcap:  # check the extra and the target before simulating
@@ -166,7 +183,7 @@ def _run(args: argparse.Namespace) -> int:
     if not args.no_plot:
         from anyplan.viz.run import save_run_figure
 
-        save_run_figure(scenario, result, out / f"run.{args.format}")
+        save_run_figure(scenario, result, out / f"run.{fmt}")
     print(summary(result, out))
     if args.mcap:
         from anyplan.experiments.mcap_log import write_mcap
@@ -175,7 +192,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.animate:
         from anyplan.viz.animation import animate_run
 
-        print(f"  animation      {animate_run(scenario, result, args.animate, speed=args.speed)}")
+        print(f"  animation      {animate_run(scenario, result, args.animate, speed=speed)}")
     return 0 if result.reached_goal else 1
 
 
