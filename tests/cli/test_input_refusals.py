@@ -167,6 +167,34 @@ def test_run_speed_and_format_where_they_apply(tmp_path, scenario, capsys):
     assert (tmp_path / "c.gif").exists() and not list((tmp_path / "c").glob("run.*"))
 
 
+@pytest.mark.parametrize(("extra", "words"), [
+    (["--planner", "visgraph", "--time", "0.5"],
+     "plan: --time applies to --planner bitstar only (visgraph is exact, not anytime)"),
+    (["--planner", "visgraph", "--time", "1"], "plan: --time applies to --planner bitstar only"),
+    (["--format", "svg"], "plan: --format applies to --plot only"),
+    (["--planner", "visgraph", "--format", "png"], "plan: --format applies to --plot only"),
+])
+def test_plan_options_that_nothing_reads_are_refused(tmp_path, scenario, capsys, extra, words):
+    out = tmp_path / "p.json"
+    assert main(["plan", str(scenario), "--json", str(out), *extra]) == 2
+    _one_line(capsys, words)
+    assert not out.exists()  # refused before planning
+
+
+@pytest.mark.parametrize(("planner", "extra"), [("bitstar", ["--time", "0.05"]), ("bitstar", []),
+                                                ("visgraph", [])])
+def test_plan_time_and_format_where_they_apply(tmp_path, scenario, planner, extra):
+    import json
+
+    out, pic = tmp_path / "p.json", tmp_path / "p"
+    argv = ["plan", str(scenario), "--planner", planner, "--json", str(out), "--plot", str(pic),
+            "--format", "svg"]
+    assert main([*argv, *extra]) == 0
+    assert (tmp_path / "p.svg").exists()
+    if planner == "bitstar":  # the budget given, else the default
+        assert json.loads(out.read_text())["time_budget_s"] == (float(extra[1]) if extra else 1.0)
+
+
 @pytest.mark.parametrize(("suite", "count", "runs", "planners", "scenarios"), [
     ("random", 1000, 1000, "straight,bitstar", 6000),
     ("gaps", 1000, 11, "straight", 20000),

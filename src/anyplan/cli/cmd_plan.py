@@ -13,6 +13,8 @@ from anyplan.errors import UsageError
 from anyplan.planning.api import PLANNERS
 
 DEFAULT_TIME_S = 1.0
+#: The planners that take --time (anytime); the others are exact and plan once.
+TIMED = ("bitstar",)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -24,16 +26,27 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="built-in scenario name (see 'anyplan scenarios') or YAML file")
     p.add_argument("--planner", default="bitstar", choices=PLANNERS,
                    help="planner (default bitstar)")
-    p.add_argument("--time", type=float, default=DEFAULT_TIME_S,
-                   help=f"time budget [s] for BIT* (default {DEFAULT_TIME_S})")
+    p.add_argument("--time", type=float, default=None,
+                   help=f"--planner bitstar: its time budget [s] (default {DEFAULT_TIME_S:g}; visgraph "
+                        "is exact and takes none)")
     p.add_argument("--seed", type=checks.seed, default=0, help="random seed >= 0 (default 0)")
     p.add_argument("--json", default=None, metavar="FILE", type=checks.nonempty("a file"),
                    help="write the result as JSON")
     p.add_argument("--plot", default=None, metavar="FILE", type=checks.nonempty("a file"),
                    help="write a picture (tree, samples, informed ellipse, path): .png, .svg or .pdf")
     p.add_argument("--format", default=None, choices=("png", "svg", "pdf"),
-                   help="picture format (default: the suffix of --plot FILE)")
+                   help="with --plot: the picture format (default: the suffix of --plot FILE)")
     p.set_defaults(func=cmd_plan)
+
+
+def _refuse_unused(args: argparse.Namespace) -> None:
+    """Refuse an option that nothing would read: ``--time`` for visgraph (exact, not anytime: it
+    plans once, whatever the budget), ``--format`` without ``--plot``."""
+    if args.time is not None and args.planner not in TIMED:
+        raise UsageError(f"plan: --time applies to --planner {' or '.join(TIMED)} only ({args.planner} "
+                         "is exact, not anytime)")
+    if args.format is not None and args.plot is None:
+        raise UsageError("plan: --format applies to --plot only")
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
@@ -42,11 +55,13 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from anyplan.planning.visgraph import lower_bound
     from anyplan.world.scenario import load_scenario
 
-    if not (math.isfinite(args.time) and args.time > 0.0):
-        raise UsageError(f"plan: --time must be > 0 seconds, got {args.time}")
-    if args.time > checks.MAX_PLAN_TIME_S:
+    _refuse_unused(args)
+    budget = DEFAULT_TIME_S if args.time is None else args.time
+    if not (math.isfinite(budget) and budget > 0.0):
+        raise UsageError(f"plan: --time must be > 0 seconds, got {budget}")
+    if budget > checks.MAX_PLAN_TIME_S:
         raise UsageError(f"plan: --time must be <= {checks.MAX_PLAN_TIME_S:g} s (the stated limit), "
-                         f"got {args.time:g}")
+                         f"got {budget:g}")
     if args.json is not None:
         checks.writable_file(args.json, "plan: --json", make_parent=False)
     plot = picture_path(args.plot, args.format, "plan", "--plot") if args.plot else None
@@ -56,7 +71,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     r = scenario.robot
     problem = Problem.create(scenario.obstacle_set(), r.start[:2], r.goal, r.radius)
     planner = make_planner(args.planner, problem, rng=args.seed)
-    planner.solve(timed(args.time))
+    planner.solve(timed(budget))
     result = planner.result()
     if result.lower_bound is None and problem.start_valid() and problem.goal_valid():
         bound = lower_bound(problem)
@@ -64,7 +79,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     out = {k: v for k, v in result.to_dict().items() if k not in ("planner", "stats")}
     if args.json:
         doc = {**out, "planner": result.planner, "scenario": scenario.name, "seed": args.seed,
-               "time_budget_s": args.time, "stats": result.stats}
+               "time_budget_s": budget, "stats": result.stats}
         Path(args.json).write_text(json.dumps(doc, indent=1))
     if plot is not None:
         from anyplan.viz.planner import save_planner_figure
