@@ -195,6 +195,46 @@ def test_plan_time_and_format_where_they_apply(tmp_path, scenario, planner, extr
         assert json.loads(out.read_text())["time_budget_s"] == (float(extra[1]) if extra else 1.0)
 
 
+@pytest.mark.parametrize("suite", ["S", "paper", "paper-1,paper-2", "folder"])
+@pytest.mark.parametrize("flag", ["--random-count", "--random-seed"])
+def test_random_options_with_a_suite_that_is_not_generated_are_refused(tmp_path, scenario, capsys, suite,
+                                                                       flag):
+    (tmp_path / "folder").mkdir()
+    (tmp_path / "folder" / "s.yaml").write_text(scenario.read_text())
+    suite = {"S": str(scenario), "folder": str(tmp_path / "folder")}.get(suite, suite)
+    argv = ["bench", "--suite", suite, "--planners", "straight", "--runs", "1", "--jobs", "1",
+            "--time-limit", "1", "--no-progress", "--db", str(tmp_path / "b.db"), flag, "2"]
+    assert main(argv) == 2
+    _one_line(capsys, f"bench: {flag} applies to the generated suites only (--suite random or gaps)")
+    assert not (tmp_path / "b.db").exists()
+
+
+class _Built(Exception):
+    """What a generated suite was asked for."""
+
+
+@pytest.mark.parametrize("suite", ["random", "gaps"])
+@pytest.mark.parametrize(("extra", "asked"), [
+    ([], (0, 1)), (["--random-count", "3", "--random-seed", "5"], (5, 3)), (["--seed", "7"], (7, 1))])
+def test_random_options_reach_a_generated_suite(tmp_path, monkeypatch, suite, extra, asked):
+    import anyplan.experiments.gaps as gaps
+    import anyplan.experiments.suites as suites
+
+    def random_suite(seed, per_count):
+        raise _Built(seed, per_count)
+
+    def gap_suite(seed, n):
+        raise _Built(seed, n // 20)
+
+    monkeypatch.setattr(suites, "random_suite", random_suite)
+    monkeypatch.setattr(gaps, "gap_suite", gap_suite)
+    argv = ["bench", "--suite", suite, "--planners", "straight", "--runs", "1", "--jobs", "1",
+            "--no-progress", "--db", str(tmp_path / "b.db"), *extra]
+    with pytest.raises(_Built) as built:
+        main(argv)
+    assert built.value.args == asked
+
+
 @pytest.mark.parametrize(("suite", "count", "runs", "planners", "scenarios"), [
     ("random", 1000, 1000, "straight,bitstar", 6000),
     ("gaps", 1000, 11, "straight", 20000),

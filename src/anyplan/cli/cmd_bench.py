@@ -53,7 +53,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="run on this Dask scheduler (needs the 'dask' extra) instead of --jobs")
     p.add_argument("--seed", type=checks.seed, default=0,
                    help="master seed; run i uses a seed derived from (seed, i) (default 0)")
-    p.add_argument("--random-count", type=checks.count(1000), default=1, metavar="K",
+    p.add_argument("--random-count", type=checks.count(1000), default=None, metavar="K",
                    help="--suite random: K scenarios per number of moving obstacles 1-6; "
                         "--suite gaps: 20 x K gap worlds (default 1)")
     p.add_argument("--random-seed", type=checks.seed, default=None,
@@ -170,6 +170,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
         write_tables,
     )
 
+    _refuse_unused_random(args)
+    per_count = 1 if args.random_count is None else args.random_count
     if args.runs < 1:
         raise _usage(f"bench: --runs must be >= 1, got {args.runs}")
     if args.runs > checks.MAX_RUNS:
@@ -186,11 +188,11 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
         cfgs = bench_configs(args, [p.name for p in planners], {p.name: dict(p.config) for p in planners})
         planners = [PlannerSpec(p.name, cfgs[p.name]) for p in planners]
-    known = suite_size(args.suite, args.random_count)
+    known = suite_size(args.suite, per_count)
     if known is not None:  # a named suite: refused before it is generated
         _check_task_count(args.runs, known, len(planners))
     scenarios = resolve_suite(args.suite, random_seed=args.seed if args.random_seed is None
-                              else args.random_seed, per_count=args.random_count)
+                              else args.random_seed, per_count=per_count)
     from anyplan.cli.perception_opts import apply_perception, tracker_settings
 
     scenarios = apply_perception("bench", scenarios, args)
@@ -254,6 +256,17 @@ def cmd_bench(args: argparse.Namespace) -> int:
             raise _usage(f"bench: --out {args.out}: cannot write ({exc.strerror})") from None
         print("\nwrote " + ", ".join(str(p) for p in paths))
     return 0
+
+
+def _refuse_unused_random(args: argparse.Namespace) -> None:
+    """Refuse ``--random-count`` and ``--random-seed`` with a suite that is not generated (a
+    folder, a list, ``paper``): nothing would read them."""
+    from anyplan.experiments.suites import GENERATED
+
+    for flag, value in (("--random-count", args.random_count), ("--random-seed", args.random_seed)):
+        if value is not None and args.suite not in GENERATED:
+            raise _usage(f"bench: {flag} applies to the generated suites only (--suite "
+                         f"{' or '.join(GENERATED)})")
 
 
 def _check_task_count(runs: int, scenarios: int, planners: int) -> None:

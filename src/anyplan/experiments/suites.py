@@ -22,7 +22,7 @@ from anyplan.experiments.generate import random_suite
 from anyplan.registry import Registry
 from anyplan.world.scenario import Scenario, load_scenario
 
-__all__ = ["resolve_suite", "suite_size", "PAPER_SUITE", "SUITES", "SuiteError"]
+__all__ = ["resolve_suite", "suite_size", "PAPER_SUITE", "SUITES", "GENERATED", "SuiteError"]
 
 PAPER_SUITE = ("paper-1", "paper-2", "paper-3")
 
@@ -58,6 +58,8 @@ _SIZES: dict[str, Callable[[int], int]] = {
     "random": lambda per_count: 6 * per_count,  # numbers of moving obstacles 1-6
     "gaps": lambda per_count: 20 * per_count,
 }
+#: The named suites generated from ``random_seed`` and ``per_count``; every other suite reads neither.
+GENERATED = ("random", "gaps")
 
 
 def suite_size(suite: str, per_count: int = 1) -> int | None:
