@@ -209,6 +209,18 @@ def test_random_options_with_a_suite_that_is_not_generated_are_refused(tmp_path,
     assert not (tmp_path / "b.db").exists()
 
 
+@pytest.mark.parametrize("suite", ["S", "paper"])
+def test_bench_planning_random_count_with_a_suite_that_is_not_generated_is_refused(tmp_path, scenario, capsys,
+                                                                                     suite):
+    db = tmp_path / "b.db"
+    argv = ["bench-planning", "--suite", str(scenario) if suite == "S" else suite, "--runs", "1",
+            "--budget", "0.01", "--ompl", "none", "--no-progress", "--db", str(db), "--random-count", "2"]
+    assert main(argv) == 2
+    _one_line(capsys, "bench-planning: --random-count applies to the generated suites only "
+                      "(--suite planning, random or gaps)")
+    assert not db.exists()
+
+
 class _Built(Exception):
     """What a generated suite was asked for."""
 
@@ -232,6 +244,21 @@ def test_random_options_reach_a_generated_suite(tmp_path, monkeypatch, suite, ex
             "--no-progress", "--db", str(tmp_path / "b.db"), *extra]
     with pytest.raises(_Built) as built:
         main(argv)
+    assert built.value.args == asked
+
+
+@pytest.mark.parametrize(("extra", "asked"), [
+    ([], (0, 4)), (["--random-count", "3", "--seed", "2"], (2, 12))])
+def test_bench_planning_random_count_reaches_the_planning_suite(tmp_path, monkeypatch, extra, asked):
+    import anyplan.experiments.planning_problems as problems
+
+    def planning_suite(seed, count):
+        raise _Built(seed, count)
+
+    monkeypatch.setattr(problems, "planning_suite", planning_suite)
+    with pytest.raises(_Built) as built:
+        main(["bench-planning", "--runs", "1", "--ompl", "none", "--no-progress",
+              "--db", str(tmp_path / "b.db"), *extra])
     assert built.value.args == asked
 
 

@@ -94,7 +94,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument("--db", default="results.db", type=checks.nonempty("a database file"),
                    help="SQLite results database (default results.db)")
     q.add_argument("--seed", type=checks.seed, default=0, help="master seed (default 0)")
-    q.add_argument("--random-count", type=checks.count(1000), default=1,
+    q.add_argument("--random-count", type=checks.count(1000), default=None,
                    help="--suite random or gaps: see 'anyplan bench'; --suite planning: 4 x this "
                         "many cluttered worlds (default 1)")
     q.add_argument("--resume", action="store_true", help="run only the runs missing from --db")
@@ -286,16 +286,19 @@ def cmd_bench_planning(args: argparse.Namespace) -> int:
         planning_table,
         run_planning_bench,
     )
-    from anyplan.experiments.suites import resolve_suite
+    from anyplan.experiments.suites import GENERATED, resolve_suite
 
+    generated = ("planning", *GENERATED)
+    if args.random_count is not None and args.suite not in generated:
+        raise _usage(f"bench-planning: --random-count applies to the generated suites only (--suite "
+                     f"{', '.join(generated[:-1])} or {generated[-1]})")
+    per_count = 1 if args.random_count is None else args.random_count
     if args.suite == "planning":
         from anyplan.experiments.planning_problems import planning_suite
 
-        if args.random_count < 1:
-            raise _usage(f"bench-planning: --random-count must be >= 1, got {args.random_count}")
-        scenarios = planning_suite(args.seed, count=4 * args.random_count)
+        scenarios = planning_suite(args.seed, count=4 * per_count)
     else:
-        scenarios = resolve_suite(args.suite, random_seed=args.seed, per_count=args.random_count)
+        scenarios = resolve_suite(args.suite, random_seed=args.seed, per_count=per_count)
     choice = args.ompl.strip().lower()
     if choice == "auto":
         ompl = list(OMPL_DEFAULT) if ompl_available() else []
