@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -77,6 +78,18 @@ def test_python_dash_m_entry_point(tmp_path):
                        text=True, cwd=tmp_path, timeout=120)
     assert p.returncode == 2
     assert "Traceback" not in p.stderr and "unknown scenario 'nope'" in p.stderr
+
+
+def test_a_reader_gone_early_ends_the_command_quietly(tmp_path):
+    # `anyplan planners --settings | head -1`, with the reader gone before the first line
+    r, w = os.pipe()
+    os.close(r)
+    try:
+        p = subprocess.run([sys.executable, "-m", "anyplan", "planners", "--settings"], stdout=w,
+                           stderr=subprocess.PIPE, text=True, cwd=tmp_path, timeout=120)
+    finally:
+        os.close(w)
+    assert p.returncode == 141 and p.stderr == ""  # as a command killed by SIGPIPE: no traceback
 
 
 def test_core_layers_do_not_import_matplotlib():

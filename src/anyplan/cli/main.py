@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import os
 import sys
 from collections.abc import Sequence
 
@@ -69,7 +70,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit code (0 success, 1 failure, 2 bad input)."""
+    """Run the command line; returns the exit code (0 success, 1 failure, 2 bad input, 130
+    interrupted, 141 its output's reader gone: ``anyplan bench ... | head``)."""
     pick_headless_backend()  # Agg for the commands that draw, unless the user chose a backend
     # logging first: building the parser finds the plugins, whose refusals are warnings
     configured = not logging.getLogger().handlers
@@ -79,7 +81,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     if configured:  # an application that set up logging keeps its level
         logging.getLogger().setLevel(logging.WARNING - 10 * min(args.verbose, 2))
     try:
-        return int(args.func(args))
+        code = int(args.func(args))
+        sys.stdout.flush()  # a reader gone early (| head) is met here, not at the interpreter's exit
+        return code
+    except BrokenPipeError:
+        # Stop quietly, as a command killed by SIGPIPE does (Python ignores the signal and
+        # raises instead); what is still buffered goes nowhere, not to another error at exit.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 128 + 13  # SIGPIPE
     except AnyplanError as exc:
         sys.stderr.write(one_line(f"anyplan: error: {exc.told_with(FLAGS)}") + "\n")
         return 2
