@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from anyplan.trajectory.spacetime import edge_ok, lattice_dt, plan_velocity
+from anyplan.trajectory.spacetime.lattice import MAX_LATTICE_CELLS, bounded_lattice, lattice_cells
 
 DS, H = 0.05, 0.05
 A, V = 0.4, 0.4
@@ -246,3 +247,34 @@ def test_goal_bounds_equal_their_recurrence_bit_for_bit(seed):
         got = goal_times(forbidden, t_map, h, c_goal, reach, ds, v_max, c_first)
         want = _goal_times_by_definition(forbidden, t_map, h, c_goal, reach, ds, v_max, c_first)
         assert np.array_equal(got, want)
+
+
+@pytest.mark.parametrize("a_max", [0.001, 1000.0])
+def test_a_robot_at_the_schemas_acceleration_limits_gets_a_bounded_lattice(a_max):
+    # a_max = 0.001 made 1600 speed levels and a_max = 1000 a step of 0.2 ms: the search's
+    # dense arrays asked for 10^11 bytes (MemoryError in st-bitstar's first re-timing).
+    length = 4.0
+    x0, x1 = _caps(length)
+    forbidden = np.zeros((4000, len(x0)), dtype=bool)
+    forbidden[:100, 40:60] = True  # s in [2, 3] m blocked during the first 5 s
+    dt, kmax, a = bounded_lattice(V, a_max, 0.25, 200.0, length, len(x0))
+    assert lattice_cells(dt, kmax, a, 200.0, length, len(x0)) <= MAX_LATTICE_CELLS
+    assert a <= a_max and kmax * a * dt == pytest.approx(V)
+    plan = plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, 0.0, a_max, V,
+                         horizon_s=200.0)
+    assert plan is not None
+    assert np.all(np.abs(plan.a) <= a_max * (1 + 1e-9)) and np.all(plan.v <= V + 1e-9)
+    t = np.arange(plan.t[0], plan.t[-1], 1e-2)
+    s, _, _ = plan.at_time(t)
+    row = np.clip((t / H).astype(int), 0, forbidden.shape[0] - 1)
+    cell = np.clip((s / DS).astype(int), 0, forbidden.shape[1] - 1)
+    assert not forbidden[row, cell].any()
+    assert plan.v[-1] == 0.0 and plan.s[-1] <= length + 1e-9
+
+
+def test_the_usual_robots_keep_their_lattice():
+    # The bound changes nothing below it: the paper's robot on a 30 m path, a Jackal.
+    for v, a, length, horizon in ((0.4, 0.4, 30.0, 105.0), (2.0, 20.0, 10.0, 35.0),
+                                  (1.0, 1.0, 30.0, 60.0)):
+        ncell = int(math.ceil(length / DS))
+        assert bounded_lattice(v, a, 0.25, horizon, length, ncell) == (*lattice_dt(v, a), a)

@@ -303,3 +303,21 @@ def test_rows_after_every_predictions_end_are_free_and_the_rest_as_computed_in_f
         assert np.array_equal(cut.forbidden, full.forbidden) and cut.forbidden.any()
         starts = cut.t_map + cut.h * np.arange(cut.forbidden.shape[0])
         assert not cut.forbidden[starts > last].any() and (starts > last).sum() > 100
+
+
+def test_a_map_beyond_its_bound_gets_wider_cells_and_the_timing_stays_free(monkeypatch):
+    # A 1 km path (an arena of the schema's 1000 m) made a map of 10^9 cells: 13 GB and five
+    # minutes for one re-timing. Here the bound is made small to show what happens beyond it.
+    import anyplan.trajectory.spacetime.timing as timing
+
+    monkeypatch.setattr(timing, "MAX_MAP_CELLS", 20_000)
+    tr = _straight()
+    ob = _crossing()
+    res = retime(tr, [ob], SPEC, margin=0.05)
+    assert res.stmap is not None and res.stmap.forbidden.size <= 20_000
+    assert res.stmap.ds > 0.05
+    assert res.trajectory is not None
+    assert first_collision(res.trajectory, [ob], SPEC.radius, margin=0.05) is None
+    assert timing.map_ds(0.05, 8.0, 60.0, 0.05) > 0.05
+    monkeypatch.undo()
+    assert timing.map_ds(0.05, 30.0, 105.0, 0.05) == 0.05  # the paper's robot on 30 m

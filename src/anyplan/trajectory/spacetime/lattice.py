@@ -21,7 +21,15 @@ import numpy as np
 
 from anyplan.trajectory.spacetime._lattice_kernels import LatticeMap, edge_ok, goal_times, search
 
-__all__ = ["VelocityPlan", "plan_velocity", "lattice_dt", "edge_ok", "goal_times"]
+__all__ = ["VelocityPlan", "plan_velocity", "lattice_dt", "bounded_lattice", "lattice_cells",
+           "edge_ok", "goal_times", "MAX_LATTICE_CELLS"]
+
+#: Largest velocity lattice searched, in cells of the search's dense arrays (one byte each, see
+#: :func:`lattice_cells`). The robots of the built-in, generated and benchmark scenarios need
+#: below 10^7 (the paper's robot on a 30 m path: 6 x 10^6); a robot at the schema's limits
+#: (a_max 0.001 or 1000 m/s^2) or a path of hundreds of metres asked for 10^9 to 10^11 and
+#: failed with MemoryError (:func:`bounded_lattice`).
+MAX_LATTICE_CELLS = 2 ** 27
 
 
 @dataclass(frozen=True)
@@ -68,6 +76,36 @@ def lattice_dt(v_max: float, a_max: float, target_dt: float = 0.25) -> tuple[flo
     return v_max / (a_max * k), k
 
 
+def lattice_cells(dt: float, kmax: int, a: float, horizon_s: float, length: float,
+                  ncell: int) -> int:
+    """Cells of the search's dense arrays for a lattice of step ``dt`` [s], ``kmax`` speed
+    levels and acceleration ``a`` [m/s^2] over ``horizon_s`` [s] on a path of ``length`` [m]
+    and ``ncell`` map columns: (steps + 1) x (kmax + 1) x (positions + map columns)."""
+    n = int(math.ceil(horizon_s / dt)) + 1
+    m = int(math.floor(length / (0.5 * a * dt * dt))) + 2
+    return n * (kmax + 1) * (m + ncell)
+
+
+def bounded_lattice(v_max: float, a_max: float, target_dt: float, horizon_s: float, length: float,
+                    ncell: int) -> tuple[float, int, float]:
+    """Step ``dt`` [s], speed levels K and acceleration ``a`` <= ``a_max`` [m/s^2] of the
+    lattice (v_max = K a dt): :func:`lattice_dt`'s, unless its arrays would exceed
+    :data:`MAX_LATTICE_CELLS`; then the step is doubled until they fit (fewer speed levels,
+    and, once there are two, a smaller acceleration than the robot's: a motion of the coarser
+    lattice is as feasible, it may only arrive later). A tiny ``a_max`` makes thousands of speed
+    levels, a huge one a step of microseconds, and a long path or horizon many positions and
+    steps: all are the product of the three sizes.
+    """
+    a = a_max
+    dt, kmax = lattice_dt(v_max, a, target_dt)
+    while lattice_cells(dt, kmax, a, horizon_s, length, ncell) > MAX_LATTICE_CELLS \
+            and dt < horizon_s:
+        target_dt = 2.0 * dt
+        a = min(a_max, v_max / (2.0 * target_dt))
+        dt, kmax = lattice_dt(v_max, a, target_dt)
+    return dt, kmax, a
+
+
 def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap0: np.ndarray,
                   xcap1: np.ndarray, length: float, t0: float, v0: float, a_max: float,
                   v_max: float, *, target_dt: float = 0.25, horizon_s: float = 60.0,
@@ -87,7 +125,8 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
         v0: Start speed [m/s] (0 <= v0 <= v_max).
         a_max: Acceleration limit [m/s^2].
         v_max: Speed limit [m/s].
-        target_dt: Approximate lattice step [s] (see :func:`lattice_dt`).
+        target_dt: Approximate lattice step [s] (see :func:`lattice_dt`; coarser when the
+            lattice would be too large, :func:`bounded_lattice`).
         horizon_s: Latest arrival considered, counted from t0 [s].
         key_cells: The search keeps one node per (step, speed, ``key_cells`` map cells): the
             first reached, which has the best estimate. Coarser keys search faster; the motion
@@ -102,7 +141,8 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
     Returns:
         The :class:`VelocityPlan`, or None if no lattice motion reaches the end in the horizon.
     """
-    dt, kmax = lattice_dt(v_max, a_max, target_dt)
+    ncell = forbidden.shape[1]
+    dt, kmax, a_max = bounded_lattice(v_max, a_max, target_dt, horizon_s, length, ncell)
     vstep = a_max * dt
     delta = 0.5 * a_max * dt * dt
     v0 = min(max(float(v0), 0.0), v_max)
@@ -121,7 +161,6 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
             if not edge_ok(forbidden, t_map, h, ds, xcap0, xcap1, t0, 0.0, v0, acc, tau):
                 continue
             starts.append((t0 + tau, v0 * tau + 0.5 * acc * tau * tau, k, acc, tau))
-    ncell = forbidden.shape[1]
     c_goal = min(int(math.floor((length - 2.0 * delta) / ds)), ncell - 1)
     reach = int(math.ceil(v_max * h / ds)) + 1
     lm = LatticeMap(forbidden, float(t_map), float(h), float(ds), xcap0, xcap1)

@@ -31,7 +31,13 @@ from anyplan.trajectory.spline import SmoothCurve
 from anyplan.trajectory.trajectory import CurveSegment, Segment, Trajectory
 from anyplan.world.robot import RobotSpec
 
-__all__ = ["TimedCurveSegment", "speed_caps", "retime", "verify", "RetimeResult"]
+__all__ = ["TimedCurveSegment", "speed_caps", "retime", "verify", "RetimeResult", "map_ds",
+           "MAX_MAP_CELLS"]
+
+#: Largest s-t map of a re-timing, in cells (rows x columns; with the goal-time bounds, nine
+#: bytes each). The built-in, generated and benchmark scenarios need below 10^7 (the paper's
+#: robot on a 30 m path: 1.3 x 10^6); a 1 km path asked for 10^9 (13 GB) (:func:`map_ds`).
+MAX_MAP_CELLS = 2 ** 25
 
 
 class TimedCurveSegment(Segment):
@@ -94,6 +100,17 @@ def _cell_max(s: np.ndarray, kmax: np.ndarray, dkmax: np.ndarray, ds: float, nce
     return kk, dk
 
 
+def map_ds(ds: float, length: float, horizon_s: float, h: float) -> float:
+    """The s-t map's cell width [m]: ``ds``, or wider when a map of ``horizon_s`` / ``h`` rows
+    [s] by ``length`` / ``ds`` columns [m] would exceed :data:`MAX_MAP_CELLS` (a path of
+    hundreds of metres, or a robot so slow that its motion lasts hours). A wider cell is
+    conservative (a disc is marked on every cell it comes within half a cell of)."""
+    nrow = int(math.ceil(horizon_s / h)) + 1
+    if nrow * math.ceil(length / ds) <= MAX_MAP_CELLS:
+        return ds
+    return max(ds, length / max(1, MAX_MAP_CELLS // nrow))
+
+
 class RetimeResult:
     """A re-timed motion and what was learnt on the way.
 
@@ -151,6 +168,7 @@ def retime(traj: Trajectory, obstacles: Sequence[Any], spec: RobotSpec, *, margi
     def points_at(s: np.ndarray) -> np.ndarray:
         return curve.position(curve.u_of_s(s))
 
+    ds = map_ds(ds, length, horizon, rows.h if rows is not None else h)
     stmap = build_stmap(points_at, length, obstacles, spec.radius, seg.t0, horizon, margin=margin,
                         ds=ds, h=h, free_tail_m=free_tail_m, rows=rows)
     x0, x1 = speed_caps(seg.profile, spec, ds, stmap.forbidden.shape[1])
