@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
 from anyplan.cli import checks
@@ -159,7 +160,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         parse_planners,
         run_bench,
     )
-    from anyplan.experiments.suites import resolve_suite, suite_size
+    from anyplan.experiments.suites import GENERATED, resolve_suite, suite_size
     from anyplan.experiments.tables import (
         compare_planners,
         format_comparisons,
@@ -170,8 +171,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         write_tables,
     )
 
-    _refuse_unused_random(args)
-    per_count = 1 if args.random_count is None else args.random_count
+    per_count = _random_count("bench", args, GENERATED)
     if args.runs < 1:
         raise _usage(f"bench: --runs must be >= 1, got {args.runs}")
     if args.runs > checks.MAX_RUNS:
@@ -258,15 +258,15 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
-def _refuse_unused_random(args: argparse.Namespace) -> None:
-    """Refuse ``--random-count`` and ``--random-seed`` with a suite that is not generated (a
-    folder, a list, ``paper``): nothing would read them."""
-    from anyplan.experiments.suites import GENERATED
-
-    for flag, value in (("--random-count", args.random_count), ("--random-seed", args.random_seed)):
-        if value is not None and args.suite not in GENERATED:
-            raise _usage(f"bench: {flag} applies to the generated suites only (--suite "
-                         f"{' or '.join(GENERATED)})")
+def _random_count(command: str, args: argparse.Namespace, generated: Sequence[str]) -> int:
+    """``--random-count`` (default 1), after refusing it and ``--random-seed`` (where the command
+    has it) with a suite not among ``generated``: nothing would read them."""
+    for flag, value in (("--random-count", args.random_count),
+                        ("--random-seed", getattr(args, "random_seed", None))):
+        if value is not None and args.suite not in generated:
+            raise _usage(f"{command}: {flag} applies to the generated suites only (--suite "
+                         f"{', '.join(generated[:-1])} or {generated[-1]})")
+    return 1 if args.random_count is None else int(args.random_count)
 
 
 def _check_task_count(runs: int, scenarios: int, planners: int) -> None:
@@ -288,11 +288,7 @@ def cmd_bench_planning(args: argparse.Namespace) -> int:
     )
     from anyplan.experiments.suites import GENERATED, resolve_suite
 
-    generated = ("planning", *GENERATED)
-    if args.random_count is not None and args.suite not in generated:
-        raise _usage(f"bench-planning: --random-count applies to the generated suites only (--suite "
-                     f"{', '.join(generated[:-1])} or {generated[-1]})")
-    per_count = 1 if args.random_count is None else args.random_count
+    per_count = _random_count("bench-planning", args, ("planning", *GENERATED))
     if args.suite == "planning":
         from anyplan.experiments.planning_problems import planning_suite
 
