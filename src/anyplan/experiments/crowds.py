@@ -373,10 +373,9 @@ def import_crowd(path: str | Path, out_dir: str | Path, options: CrowdOptions | 
     p = Path(path)
     if name is not None:
         _check_name(name)
-    opt = options or CrowdOptions()
     tracks = read_obsmat(p)
     base = name or p.stem.replace("_obsmat", "").replace("_", "-")
-    scenarios = crowd_scenarios(tracks, base, opt, source=str(p))
+    scenarios = crowd_scenarios(tracks, base, options, source=str(p))
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = []
