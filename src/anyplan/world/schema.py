@@ -295,8 +295,7 @@ MOTION_TYPES.register("track", _parse_track)
 def parse_sensing(c: Ctx, obj: Any) -> SensingSpec:
     """The ``sensing:`` block."""
     m = c.mapping(obj, "sensing")
-    c.keys(m, "sensing", ("mode",), ("noise_m", "rate_hz", "association", "detection_prob",
-                                     "clutter_rate", "occlusion"))
+    c.keys(m, "sensing", ("mode",), TRACKED_ONLY)  # every setting but the mode is tracked's
     mode = c.string(m["mode"], "sensing.mode")
     if mode in MODES and mode != "tracked":
         for key in TRACKED_ONLY:
