@@ -302,6 +302,22 @@ def _barn(capsys, tmp_path, data, *words):
     return err
 
 
+@pytest.mark.parametrize(("command", "flag", "module", "error", "input_name", "dataset"), [
+    ("import-barn", "--source", barn, barn.BARNError, "source", "BARN"),
+    ("import-dynabarn", "--worlds-file", dynabarn, dynabarn.DynaBARNError, "worlds_file", "DynaBARN"),
+])
+def test_a_missing_worlds_file_names_the_importers_own_input(tmp_path, capsys, command, flag, module,
+                                                             error, input_name, dataset):
+    missing = tmp_path / "none.json"
+    with pytest.raises(error) as ei:
+        module.load_worlds(missing)
+    assert str(ei.value) == f"{missing}: no such file (pass {input_name} PATH to the {dataset} worlds.json)"
+    assert ei.value.subject == str(missing) and ei.value.also == (input_name,)
+    _refused(capsys, [command, flag, str(missing), "--out", str(tmp_path / "o")],
+             f"{missing}: no such file (pass {flag} PATH to the {dataset} worlds.json)")
+    assert not (tmp_path / "o").exists()
+
+
 @pytest.mark.parametrize(("data", "words"), [
     ([{**BARN_WORLD, "world": -3}], ("[0].world: must be in [0, 999] (the stated limit), got -3",)),
     ([{**BARN_WORLD, "world": 1000}], ("[0].world: must be in [0, 999]",)),

@@ -67,9 +67,7 @@ def _num(obj: Any, where: str, positive: bool = False) -> float:
 _WORLD_KEYS = ("world", "cylinders", "reference_path_length_m")
 
 
-def _check_world(w: Any, k: int, src: str) -> None:
-    idx = dynabarn.world_index(w, f"{src}: [{k}]", BARNError)
-    where = f"{src}: world {idx}"
+def _check_world(w: Mapping[str, Any], where: str) -> None:
     dynabarn.check_keys(w, _WORLD_KEYS, where, BARNError)
     _num(w.get("reference_path_length_m"), f"{where}.reference_path_length_m", positive=True)
     cyl = w.get("cylinders")
@@ -95,22 +93,7 @@ def load_worlds(path: str | Path) -> list[dict[str, Any]]:
         BARNError: missing, unreadable, not a JSON list of worlds, or a malformed world (naming
             the file, the world and the field).
     """
-    p = Path(path)
-    if not p.is_file():
-        raise BARNError.about(str(p), ": no such file (pass {source} PATH to the BARN worlds.json)", "source")
-    try:
-        data = json.loads(p.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise BARNError(f"{p}: not a readable JSON file ({type(exc).__name__})") from None
-    if not isinstance(data, list) or not data:
-        raise BARNError(f"{p}: expected a non-empty JSON list of worlds")
-    seen: dict[int, int] = {}
-    for k, w in enumerate(data):
-        _check_world(w, k, str(p))
-        if w["world"] in seen:
-            raise BARNError(f"{p}: world {w['world']} appears twice ([{seen[w['world']]}] and [{k}])")
-        seen[w["world"]] = k
-    return data
+    return dynabarn.read_worlds(path, BARNError, "source", "BARN", _check_world)
 
 
 def parse_worlds(spec: str, n_worlds: int = N_WORLDS) -> list[int]:

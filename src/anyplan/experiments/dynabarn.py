@@ -17,7 +17,7 @@ import difflib
 import json
 import math
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -27,8 +27,8 @@ from anyplan.world.scenario import scenario_from_dict
 from anyplan.world.yaml_load import dump_yaml
 
 __all__ = ["JACKAL", "SHIFT", "ARENA", "DynaBARNError", "default_worlds_path", "load_worlds",
-           "parse_worlds", "world_to_scenario", "convert", "tier", "world_index", "check_keys",
-           "finite", "converted_error"]
+           "read_worlds", "parse_worlds", "world_to_scenario", "convert", "tier", "world_index",
+           "check_keys", "finite", "converted_error"]
 
 #: Clearpath Jackal profile (docs/experiments.md, "DynaBARN conventions"), SI units.
 JACKAL: dict[str, float] = {"radius": 0.34, "v_max": 2.0, "omega_max": 2.0, "a_max": 2.0,
@@ -65,22 +65,37 @@ def load_worlds(path: str | Path) -> list[dict[str, Any]]:
         DynaBARNError: missing, unreadable, not a non-empty JSON list of worlds, a bad,
             missing or repeated world index or an unknown key (naming the file and the field).
     """
+    return read_worlds(path, DynaBARNError, "worlds_file", "DynaBARN",
+                       lambda w, where: check_keys(w, _WORLD_KEYS, where, DynaBARNError))
+
+
+def read_worlds(path: str | Path, error: type[AnyplanError], option: str, dataset: str,
+                check: Callable[[Mapping[str, Any], str], None]) -> list[dict[str, Any]]:
+    """The worlds of a challenge's ``worlds.json`` (``dataset``: ``DynaBARN``, ``BARN``): a
+    non-empty JSON list, each item with a distinct :func:`world_index` and passing ``check``
+    (given the world and ``FILE: world N`` to name it in its errors).
+
+    Raises:
+        error: missing (the message names the input ``option``, e.g. ``worlds_file``),
+            unreadable, not a non-empty JSON list, a bad or repeated index, or what ``check``
+            raises.
+    """
     p = Path(path)
     if not p.is_file():
-        raise DynaBARNError.about(
-            str(p), ": no such file (pass {worlds_file} PATH to the DynaBARN worlds.json)", "worlds_file")
+        raise error.about(str(p), f": no such file (pass {{{option}}} PATH to the {dataset} worlds.json)",
+                          option)
     try:
         data = json.loads(p.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise DynaBARNError(f"{p}: not a readable JSON file ({type(exc).__name__})") from None
+        raise error(f"{p}: not a readable JSON file ({type(exc).__name__})") from None
     if not isinstance(data, list) or not data:
-        raise DynaBARNError(f"{p}: expected a non-empty JSON list of worlds")
+        raise error(f"{p}: expected a non-empty JSON list of worlds")
     seen: dict[int, int] = {}
     for k, w in enumerate(data):
-        idx = world_index(w, f"{p}: [{k}]", DynaBARNError)
-        check_keys(w, _WORLD_KEYS, f"{p}: world {idx}", DynaBARNError)
+        idx = world_index(w, f"{p}: [{k}]", error)
+        check(w, f"{p}: world {idx}")
         if idx in seen:
-            raise DynaBARNError(f"{p}: world {idx} appears twice ([{seen[idx]}] and [{k}])")
+            raise error(f"{p}: world {idx} appears twice ([{seen[idx]}] and [{k}])")
         seen[idx] = k
     return data
 
