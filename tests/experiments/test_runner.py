@@ -151,6 +151,33 @@ def test_a_registered_object_that_is_not_an_agent_class_is_refused_before_any_ru
         AGENTS._origins.pop("not-an-agent")
 
 
+def test_plan_tasks_looks_each_planner_up_once_and_still_checks_every_planner_before_any_config(
+        tiny_file, monkeypatch):
+    from anyplan.errors import UnknownNameError
+    from anyplan.experiments import runner
+
+    calls: list[str] = []
+    lookup = runner._planner_entry
+
+    def counted(name: str) -> str | None:
+        calls.append(name)
+        return lookup(name)
+
+    monkeypatch.setattr(runner, "_planner_entry", counted)
+    sc = load_scenario(tiny_file)
+    tasks = plan_tasks([sc], [PlannerSpec("straight", {"heading_gain": "1.5"}), PlannerSpec("half-speed")],
+                       2, 0)
+    assert calls == ["straight", "half-speed"]
+    assert [(t.planner, t.planner_config, t.planner_entry) for t in tasks[:2]] == [
+        ("straight", {"heading_gain": 1.5}, lookup("straight")),
+        ("half-speed", {}, "anyplan_bench_test_agents:HalfSpeedAgent")]
+    # an unknown planner listed after a bad config is still the error told
+    calls.clear()
+    with pytest.raises(UnknownNameError, match="unknown planner 'strait'"):
+        plan_tasks([sc], [PlannerSpec("straight", {"heading_gain": "x"}), PlannerSpec("strait")], 1, 0)
+    assert calls == ["straight", "strait"]
+
+
 def test_a_library_config_is_checked_as_bench_config_is(tmp_path, tiny_file):
     sc = load_scenario(tiny_file)
     with pytest.raises(BenchError, match=r"^config straight: heading_gain='x': planner 'straight' "

@@ -107,6 +107,11 @@ def check_planner_config(spec: PlannerSpec) -> PlannerSpec:
             class (:func:`_planner_entry`).
     """
     _planner_entry(spec.name)
+    return _checked_config(spec)
+
+
+def _checked_config(spec: PlannerSpec) -> PlannerSpec:
+    """:func:`check_planner_config` once the planner is known to be an agent class."""
     if not spec.config:
         return spec
     try:
@@ -209,8 +214,8 @@ def plan_tasks(scenarios: Sequence[Scenario], planners: Sequence[PlannerSpec], r
     if runs < 1:
         raise BenchError.about("runs", f" must be >= 1, got {runs}")
     sim = sim if sim is not None else _sim_config(dt, time_limit)
-    entries = {p.name: _planner_entry(p.name) for p in planners}
-    checked = [check_planner_config(p) for p in planners]
+    entries = {p.name: _planner_entry(p.name) for p in planners}  # every planner, then every config
+    checked = [_checked_config(p) for p in planners]
     tasks = []
     for i in range(runs):
         seed = derive_seed(master_seed, i)
