@@ -26,6 +26,8 @@ def test_plan_writes_json_and_plot(tmp_path, capsys, planner):
                 "lower_bound"):
         assert key in doc
     assert doc["status"] == "exact"
+    # the budget recorded is the one given; visgraph has none (and refuses --time)
+    assert doc["time_budget_s"] == (0.05 if planner == "bitstar" else None)
     path = np.array(doc["path"])
     rects = [(3.0, 0.0, 5.0, 7.0), (7.0, 4.0, 9.0, 11.0), (10.5, 2.0, 12.5, 8.0)]
     obs = ObstacleSet([Polygon([[a, b], [c, b], [c, d], [a, d]]) for a, b, c, d in rects],

@@ -56,12 +56,14 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from anyplan.world.scenario import load_scenario
 
     _refuse_unused(args)
-    budget = DEFAULT_TIME_S if args.time is None else args.time
-    if not (math.isfinite(budget) and budget > 0.0):
-        raise UsageError(f"plan: --time must be > 0 seconds, got {budget}")
-    if budget > checks.MAX_PLAN_TIME_S:
-        raise UsageError(f"plan: --time must be <= {checks.MAX_PLAN_TIME_S:g} s (the stated limit), "
-                         f"got {budget:g}")
+    budget: float | None = None  # an exact planner has none (and refused --time above)
+    if args.planner in TIMED:
+        budget = DEFAULT_TIME_S if args.time is None else args.time
+        if not (math.isfinite(budget) and budget > 0.0):
+            raise UsageError(f"plan: --time must be > 0 seconds, got {budget}")
+        if budget > checks.MAX_PLAN_TIME_S:
+            raise UsageError(f"plan: --time must be <= {checks.MAX_PLAN_TIME_S:g} s (the stated limit), "
+                             f"got {budget:g}")
     if args.json is not None:
         checks.writable_file(args.json, "plan: --json", make_parent=False)
     plot = picture_path(args.plot, args.format, "plan", "--plot") if args.plot else None
@@ -71,7 +73,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     r = scenario.robot
     problem = Problem.create(scenario.obstacle_set(), r.start[:2], r.goal, r.radius)
     planner = make_planner(args.planner, problem, rng=args.seed)
-    planner.solve(timed(budget))
+    planner.solve(timed(budget) if budget is not None else 0.0)  # visgraph: the ptc is not consulted
     result = planner.result()
     if result.lower_bound is None and problem.start_valid() and problem.goal_valid():
         bound = lower_bound(problem)
