@@ -1,16 +1,20 @@
-"""Exceptions raised by anyplan for bad input.
+"""Exceptions raised by anyplan for bad input, and the check every layer makes of a number.
 
 Library errors name fields and parameters (``runs``, ``SimConfig.dt``), not command-line flags;
 the command line (:mod:`anyplan.cli.main`) maps them to its flags when it reports them.
+:func:`finite_float` checks that a user's value is a finite number within bounds; its callers
+(agent settings, scenario fields, worlds files, import options) tell its refusal with their own
+error type and field name.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
-from typing import Self
+from typing import Literal, Self
 
 __all__ = ["AnyplanError", "ScenarioError", "UnknownNameError", "UsageError", "one_line", "shorten",
-           "MAX_MESSAGE_CHARS"]
+           "MAX_MESSAGE_CHARS", "NumberRefused", "finite_float"]
 
 #: Longest error line printed by the command line [characters].
 MAX_MESSAGE_CHARS = 400
@@ -37,6 +41,64 @@ def shorten(value: object, limit: int = 40) -> str:
     except Exception:  # noqa: BLE001 - a repr that fails is still reported
         s = f"<{type(value).__name__}>"
     return one_line(s, limit)
+
+
+class NumberRefused(ValueError):
+    """Why :func:`finite_float` refused a value; its caller raises its own error from it.
+
+    Attributes:
+        kind: ``"type"`` (not an int or float, or a bool), ``"overflow"`` (an int beyond the
+            float range), ``"nonfinite"`` (nan or inf), ``"low"`` or ``"high"`` (out of bounds).
+        shown: The value as a message shows it: ``f"{x:g}"`` of its float, else its
+            :func:`shorten` (``"type"``, ``"overflow"``).
+
+    Its message is the reason without a field name, e.g. ``must be > 0, got -1``.
+    """
+
+    def __init__(self, kind: Literal["type", "overflow", "nonfinite", "low", "high"], reason: str,
+                 shown: str) -> None:
+        super().__init__(reason)
+        self.kind = kind
+        self.shown = shown
+
+
+def finite_float(value: object, lo: float = -math.inf, hi: float = math.inf, *,
+                 lo_open: bool = False) -> float:
+    """``value`` as a float when it is an int or float (not a bool), finite, >= ``lo`` (> ``lo``
+    with ``lo_open``) and <= ``hi``; the bounds are in the value's own unit.
+
+    Raises:
+        NumberRefused: anything else (its ``kind`` tells why, its message names no field).
+
+    Examples:
+        >>> finite_float(2, lo=0.0, lo_open=True)
+        2.0
+        >>> for bad in (True, "1", 10**400, math.nan, -math.inf, 0.0):
+        ...     try:
+        ...         finite_float(bad, lo=0.0, lo_open=True)
+        ...     except NumberRefused as exc:
+        ...         print(f"{exc.kind}: {exc}")
+        type: expected a number, got True
+        type: expected a number, got '1'
+        overflow: number too large (beyond the floating-point range)
+        nonfinite: must be finite, got nan
+        nonfinite: must be finite, got -inf
+        low: must be > 0, got 0
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise NumberRefused("type", f"expected a number, got {shorten(value)}", shorten(value))
+    try:
+        x = float(value)
+    except OverflowError:  # an int of hundreds of digits
+        raise NumberRefused("overflow", "number too large (beyond the floating-point range)",
+                            shorten(value)) from None
+    if not math.isfinite(x):
+        raise NumberRefused("nonfinite", f"must be finite, got {x:g}", f"{x:g}")
+    if x < lo or (lo_open and x == lo):
+        raise NumberRefused("low", f"must be {'>' if lo_open else '>='} {lo:g}, got {x:g}", f"{x:g}")
+    if x > hi:
+        raise NumberRefused("high", f"must be <= {hi:g}, got {x:g}", f"{x:g}")
+    return x
 
 
 class AnyplanError(Exception):

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from anyplan.errors import ScenarioError, shorten
+from anyplan.errors import NumberRefused, ScenarioError, finite_float, shorten
 from anyplan.geometry.shapes import Circle, Polygon, Shape, rectangle
 from anyplan.registry import Registry
 from anyplan.world import limits as L
@@ -87,18 +87,11 @@ class Ctx:
                lo: float | None = None, hi: float | None = None) -> float:
         """A finite number; ``lo``/``hi`` are the stated limits (inclusive), ``hi`` also
         bounds the magnitude when ``lo`` is None."""
-        if isinstance(obj, bool) or not isinstance(obj, int | float):
-            raise self.fail(fld, f"expected a number, got {typename(obj)}")
         try:
-            x = float(obj)
-        except OverflowError:
-            raise self.fail(fld, "number too large (beyond the floating-point range)") from None
-        if not math.isfinite(x):
-            raise self.fail(fld, f"must be finite, got {x}")
-        if positive and not x > 0.0:
-            raise self.fail(fld, f"must be > 0, got {x:g}")
-        if nonneg and x < 0.0:
-            raise self.fail(fld, f"must be >= 0, got {x:g}")
+            x = finite_float(obj, 0.0 if positive or nonneg else -math.inf, lo_open=positive)
+        except NumberRefused as exc:
+            raise self.fail(fld, f"expected a number, got {typename(obj)}" if exc.kind == "type"
+                            else str(exc)) from None
         if lo is not None and x < lo:
             raise self.fail(fld, f"must be >= {lo:g} (the stated limit), got {x:g}")
         if hi is not None and (x > hi or (lo is None and x < -hi)):
