@@ -53,6 +53,15 @@ def test_a_value_that_would_fail_inside_a_run_is_refused_when_built(planner, ite
         build_agent_config(AGENTS.get(planner), planner, parse_set_options([item]))
 
 
+def test_an_integer_beyond_the_float_range_is_refused_in_a_short_line():
+    from anyplan.agents.straight import StraightAgent
+
+    # checked_number raised an OverflowError here
+    with pytest.raises(ValueError, match=r"^heading_gain: must be > 0, got 1000") as info:
+        StraightAgent(heading_gain=10**400)
+    assert len(str(info.value)) < 100
+
+
 @pytest.mark.skipif(importlib.util.find_spec("pyrvo") is None, reason="needs the orca extra (pyrvo)")
 @pytest.mark.parametrize(("item", "words"), [
     ("safety_m=-1", "safety_m: must be >= 0"), ("period_s=0", "period_s: must be > 0"),

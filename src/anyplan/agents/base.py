@@ -19,6 +19,7 @@ import numpy as np
 
 from anyplan.agents.plugins import discover_plugins
 from anyplan.agents.stats import StatsRecord
+from anyplan.errors import NumberRefused, finite_float, shorten
 from anyplan.prediction.base import ObstacleObservation
 from anyplan.prediction.detection import Detection
 from anyplan.registry import LoadError, Registry
@@ -179,11 +180,10 @@ def checked_number(name: str, value: Any, lo: float = 0.0, *, lo_open: bool = Fa
         ...
         ValueError: period_s: must be > 0, got 0.0
     """
-    ok = (isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
-          and (value > lo if lo_open else value >= lo))
-    if not ok:
-        raise ValueError(f"{name}: must be {'>' if lo_open else '>='} {lo:g}, got {value!r}")
-    return float(value)
+    try:
+        return finite_float(value, lo, lo_open=lo_open)
+    except NumberRefused:
+        raise ValueError(f"{name}: must be {'>' if lo_open else '>='} {lo:g}, got {shorten(value)}") from None
 
 
 def checked_pose_margin(value: Any) -> float:
