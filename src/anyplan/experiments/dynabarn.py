@@ -21,7 +21,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from anyplan.errors import AnyplanError, ScenarioError, shorten
+from anyplan.errors import AnyplanError, NumberRefused, ScenarioError, finite_float, shorten
 from anyplan.world import limits as L
 from anyplan.world.scenario import scenario_from_dict
 from anyplan.world.yaml_load import dump_yaml
@@ -173,18 +173,14 @@ def _sy(y: float) -> float:
 def finite(obj: Any, where: str, error: type[AnyplanError], positive: bool = False,
            hi: float = L.MAX_COORD_M) -> float:
     """A JSON number: finite, within +-``hi`` (``positive``: in (0, hi])."""
-    ok = not isinstance(obj, bool) and isinstance(obj, int | float)
     try:
-        x = float(obj) if ok else math.nan
-    except OverflowError:  # an integer of hundreds of digits
-        x = math.inf
-    if not math.isfinite(x):
-        raise error(f"{where}: expected a finite number, got {shorten(obj)}")
-    if positive and x <= 0:
-        raise error(f"{where}: expected a positive number, got {x:g}")
-    if abs(x) > hi:
-        raise error(f"{where}: must be within +-{hi:g} (the stated limit), got {x:g}")
-    return x
+        return finite_float(obj, 0.0 if positive else -hi, hi, lo_open=positive)
+    except NumberRefused as exc:
+        if exc.kind in ("type", "overflow", "nonfinite"):
+            raise error(f"{where}: expected a finite number, got {shorten(obj)}") from None
+        if positive and exc.kind == "low":
+            raise error(f"{where}: expected a positive number, got {exc.shown}") from None
+        raise error(f"{where}: must be within +-{hi:g} (the stated limit), got {exc.shown}") from None
 
 
 def _num(obj: Any, where: str, positive: bool = False, hi: float = L.MAX_COORD_M) -> float:
