@@ -123,6 +123,12 @@ def test_bad_options_are_refused_when_made_before_any_file_is_read(tmp_path, cap
         CrowdOptions(noise_m=-1.0)
     _refused(capsys, ["import-crowd", str(tmp_path / "missing.txt"), "--out", str(tmp_path / "o"),
                       "--sensor-noise", "-1"], "--sensor-noise must be a finite number >= 0")
+    # an int beyond the float range: an OverflowError before; refused in one short line
+    for opts in ({"window_s": 10**400}, {"robot": {"radius": -(10**400)}}):
+        with pytest.raises(CrowdError, match=r"^(window_s|robot_radius) must be a finite number > 0, "
+                                             r"got -?1000") as info:
+            CrowdOptions(**opts)
+        assert len(str(info.value)) < 100
 
 
 def test_copies_that_coincide_are_refused(tmp_path, capsys):

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from anyplan.errors import AnyplanError, ScenarioError, one_line, shorten
+from anyplan.errors import AnyplanError, NumberRefused, ScenarioError, finite_float, one_line, shorten
 from anyplan.world import limits as L
 from anyplan.world.scenario import scenario_from_dict
 from anyplan.world.yaml_load import dump_yaml
@@ -102,14 +102,14 @@ class CrowdOptions:
 def _check_range(name: str, v: Any, floor: float, hi: float, lo: float = 0.0,
                  zero: bool = False) -> None:
     """Option ``name`` is a finite number > ``floor`` (>= with ``zero``), >= ``lo`` and <= ``hi``."""
-    ok = isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-    shown = f"{v:g}" if isinstance(v, int | float) and not isinstance(v, bool) else shorten(v)
-    if not ok or (v < floor if zero else v <= floor):
+    try:
+        x = finite_float(v, floor, lo_open=not zero)
+    except NumberRefused as exc:
         rel = ">=" if zero else ">"
-        raise CrowdError.about(name, f" must be a finite number {rel} {floor:g}, got {shown}")
-    if v < lo or v > hi:
+        raise CrowdError.about(name, f" must be a finite number {rel} {floor:g}, got {exc.shown}") from None
+    if x < lo or x > hi:
         bounds = f"[{lo:g}, {hi:g}]" if zero or lo > floor else f"({lo:g}, {hi:g}]"
-        raise CrowdError.about(name, f" must be in {bounds} (the stated limit), got {shown}")
+        raise CrowdError.about(name, f" must be in {bounds} (the stated limit), got {x:g}")
 
 
 def read_obsmat(path: str | Path) -> dict[int, np.ndarray]:
