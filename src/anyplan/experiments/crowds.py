@@ -44,9 +44,10 @@ MAX_FRAME = FRAME_RATE * L.MAX_EVENT_TIME_S
 MAX_PERSON_ID = 10**9
 #: Longest ``name`` (the prefix of the scenario names and files) [characters].
 MAX_NAME_CHARS = 100
-#: Limits of the robot options (``robot`` keys of :class:`CrowdOptions`), as the scenario's.
+#: Limits of the robot options (``robot`` keys of :class:`CrowdOptions`), as the scenario's
+#: (every option must also be > 0).
 _ROBOT_RANGES: dict[str, tuple[float, float]] = {"radius": L.ROBOT_RADIUS_M, **L.ROBOT_LIMITS,
-                                                 "goal_tolerance": (0.0, L.MAX_ARENA_M)}
+                                                 "goal_tolerance": (0.0, L.MAX_GOAL_TOLERANCE_M)}
 #: The columns of an obsmat row.
 _COLUMNS = ("frame", "person", "x", "z", "y", "vx", "vz", "vy")
 

@@ -9,7 +9,8 @@ drives at 0.4 m/s. Documented in ``docs/scenarios.md`` (section "Limits").
 from __future__ import annotations
 
 __all__ = [
-    "MAX_ARENA_M", "MAX_COORD_M", "MAX_SIZE_M", "ROBOT_RADIUS_M", "ROBOT_LIMITS", "MAX_OBSTACLE_SPEED",
+    "MAX_ARENA_M", "MAX_COORD_M", "MAX_SIZE_M", "ROBOT_RADIUS_M", "ROBOT_LIMITS", "MAX_GOAL_TOLERANCE_M",
+    "MAX_OBSTACLE_SPEED",
     "MAX_OBSTACLE_TURN_RATE", "MAX_ANGLE_RAD", "MAX_TIME_LIMIT_S", "MAX_EVENT_TIME_S",
     "MAX_STATIC_OBSTACLES", "MAX_MOVING_OBSTACLES", "MAX_POLYGON_POINTS", "MAX_KEYFRAMES",
     "MIN_DT_S", "MAX_SIM_STEPS", "MAX_SEED", "MAX_TEXT_CHARS", "MAX_SENSOR_RATE_HZ",
@@ -29,6 +30,8 @@ ROBOT_LIMITS: dict[str, tuple[float, float]] = {
     "v_max": (1e-3, 100.0), "omega_max": (1e-3, 100.0),
     "a_max": (1e-3, 1000.0), "alpha_max": (1e-3, 1000.0),
 }
+#: Largest goal tolerance of the robot [m] (it must also be > 0).
+MAX_GOAL_TOLERANCE_M = MAX_ARENA_M
 #: Largest speed of a moving obstacle [m/s].
 MAX_OBSTACLE_SPEED = 1000.0
 #: Largest turn rate of a moving obstacle [rad/s].

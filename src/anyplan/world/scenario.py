@@ -257,7 +257,7 @@ def scenario_from_dict(data: Any, source: str = "<dict>") -> Scenario:
     vals = {k: c.number(rob[k], f"robot.{k}", positive=True, lo=lo, hi=hi)
             for k, (lo, hi) in ranges.items()}
     goal_tol = c.number(rob.get("goal_tolerance", 0.2), "robot.goal_tolerance", positive=True,
-                        hi=L.MAX_ARENA_M)
+                        hi=L.MAX_GOAL_TOLERANCE_M)
     sensing = rob.get("sensing_range")
     sensing_range = None if sensing is None else c.number(sensing, "robot.sensing_range",
                                                            positive=True, hi=L.MAX_COORD_M)
