@@ -86,7 +86,8 @@ def finite_float(value: object, lo: float = -math.inf, hi: float = math.inf, *,
         low: must be > 0, got 0
     """
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise NumberRefused("type", f"expected a number, got {shorten(value)}", shorten(value))
+        shown = shorten(value)
+        raise NumberRefused("type", f"expected a number, got {shown}", shown)
     try:
         x = float(value)
     except OverflowError:  # an int of hundreds of digits
