@@ -62,6 +62,29 @@ def test_an_integer_beyond_the_float_range_is_refused_in_a_short_line():
     assert len(str(info.value)) < 100
 
 
+@pytest.mark.parametrize(("planner", "item", "shown"), [
+    ("straight", "heading_gain=" + "9" * 400, "heading_gain=999"),
+    ("straight", "align_tolerance=-" + "9" * 400, "align_tolerance=-999"),
+    ("st-bitstar", f"wait_delays_s=[1, {'9' * 400}]", "wait_delays_s=[1, 999"),  # an item of a list
+])
+def test_a_float_setting_given_an_integer_beyond_the_float_range_is_refused_by_name(planner, item, shown):
+    # _coerce's float() raised an OverflowError here
+    with pytest.raises(SettingsError) as info:
+        build_agent_config(AGENTS.get(planner), planner, parse_set_options([item]))
+    msg = str(info.value)
+    assert msg.startswith(f"setting {shown}") and "number too large" in msg, msg
+    assert len(msg) < 150 and "\n" not in msg
+
+
+@pytest.mark.parametrize("text", ["9" * 5000, "2020-13-45", "[" * 5000])
+def test_yaml_python_cannot_hold_is_refused_by_name(text):
+    # an int of more than 4300 digits or a date out of the calendar (ValueError), deep nesting
+    # (RecursionError): each escaped as itself before
+    with pytest.raises(SettingsError, match=r"^setting heading_gain: cannot read '") as info:
+        parse_set_options([f"heading_gain={text}"])
+    assert len(str(info.value)) < 120
+
+
 @pytest.mark.skipif(importlib.util.find_spec("pyrvo") is None, reason="needs the orca extra (pyrvo)")
 @pytest.mark.parametrize(("item", "words"), [
     ("safety_m=-1", "safety_m: must be >= 0"), ("period_s=0", "period_s: must be > 0"),

@@ -73,6 +73,38 @@ def test_a_good_bench_config_is_recorded_as_given_or_converted_as_set_converts(t
     assert [r["outcome"] for r in runs] != ["error", "error"] and all(r["error"] is None for r in runs)
 
 
+_HUGE = "9" * 400  # an int beyond the float range (float() raises OverflowError)
+
+
+_UNCONVERTIBLE = [
+    (f"heading_gain={_HUGE}", "--set heading_gain=999"),
+    (f"heading_gain=-{_HUGE}", "--set heading_gain=-999"),
+    ("heading_gain=" + "9" * 5000, "--set heading_gain: cannot read '999"),  # not even an int
+    ("heading_gain=2020-13-45", "--set heading_gain: cannot read '2020-13-45' as a YAML value"),
+]
+
+
+@pytest.mark.parametrize(("command", "item", "words"), [
+    *(("run", *case) for case in _UNCONVERTIBLE), *(("bench", *case) for case in _UNCONVERTIBLE),
+    ("bench", f"straight:heading_gain={_HUGE}", "--set heading_gain=999"),  # PLANNER:KEY=VALUE
+])
+def test_a_set_value_python_cannot_convert_is_refused_by_name(tmp_path, scenario, capsys, command,
+                                                              item, words):
+    out = tmp_path / "r"
+    argv = (["run", str(scenario), "--planner", "straight", "--out", str(out), "--no-plot"]
+            if command == "run" else _bench(scenario, tmp_path))
+    assert main([*argv, "--set", item]) == 2  # a traceback before (OverflowError, ValueError)
+    err = _one_line(capsys, words)
+    assert "9" * 400 not in err and ("number too large" in err or "cannot read" in err)
+    assert not out.exists() and not (tmp_path / "b.db").exists()
+
+
+def test_a_bench_config_int_beyond_the_float_range_is_refused_by_name(tmp_path, scenario, capsys):
+    assert main(_bench(scenario, tmp_path, "--config", f'straight={{"heading_gain": {_HUGE}}}')) == 2
+    _one_line(capsys, "--config straight: heading_gain=999", "number too large")
+    assert not (tmp_path / "b.db").exists()
+
+
 @pytest.mark.parametrize(("argv", "flag"), [
     (["--planners", ""], "--planners"),
     (["--planners", " "], "--planners"),

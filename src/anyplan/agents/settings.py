@@ -24,7 +24,7 @@ from typing import Any
 import yaml
 
 from anyplan.config import Spec, describe, type_name
-from anyplan.errors import AnyplanError, UnknownNameError
+from anyplan.errors import AnyplanError, NumberRefused, UnknownNameError, finite_float, one_line, shorten
 
 __all__ = ["Setting", "SettingsError", "agent_settings", "parse_set_options", "build_agent_config",
            "deterministic_settings"]
@@ -118,7 +118,8 @@ def agent_settings(cls: type) -> dict[str, Setting]:
 
 
 def _coerce(hint: Any, value: Any) -> Any:
-    """``value`` as type ``hint``; raises TypeError when it is not one."""
+    """``value`` as type ``hint``; raises TypeError when it is not one, NumberRefused (kind
+    ``"overflow"``) for an int beyond the float range where a float is expected."""
     if hint is inspect.Parameter.empty:
         return value
     if hint is type(None):
@@ -155,8 +156,10 @@ def _coerce(hint: Any, value: Any) -> Any:
             return value
         raise TypeError
     if hint is float:
-        if isinstance(value, int | float) and not isinstance(value, bool):
-            return float(value)
+        if isinstance(value, float):
+            return float(value)  # nan and inf too: the agent's own checks refuse them in its words
+        if isinstance(value, int) and not isinstance(value, bool):
+            return finite_float(value)  # an int of hundreds of digits: NumberRefused
         if isinstance(value, str):  # YAML 1.1 reads 1e-3 as a string
             try:
                 return float(value)
@@ -176,7 +179,8 @@ def parse_set_options(items: Sequence[str]) -> dict[str, Any]:
     """``["KEY=VALUE", ...]`` as a dictionary, each value parsed as a YAML scalar.
 
     Raises:
-        SettingsError: an item without ``=``, an empty key, a key given twice, or bad YAML.
+        SettingsError: an item without ``=``, an empty key, a key given twice, or bad YAML (or
+            YAML Python cannot hold: an int of more than 4300 digits, a date like 2020-13-45).
     """
     out: dict[str, Any] = {}
     for item in items:
@@ -188,8 +192,10 @@ def parse_set_options(items: Sequence[str]) -> dict[str, Any]:
             raise SettingsError.about("setting", f": '{key}' is given twice")
         try:
             out[key] = yaml.safe_load(text) if text.strip() else ""
-        except yaml.YAMLError:
-            raise SettingsError.about("setting", f" {key}: cannot read '{text}' as a YAML value") from None
+        # ValueError: an int of more than 4300 digits, a date like 2020-13-45; RecursionError: [[[...
+        except (yaml.YAMLError, ValueError, RecursionError):
+            raise SettingsError.about("setting", f" {key}: cannot read '{one_line(text, 60)}' as a YAML "
+                                      "value") from None
     return out
 
 
@@ -212,8 +218,8 @@ def build_agent_config(cls: type, planner: str, options: dict[str, Any],
     checked against :func:`agent_settings`; the agent is built once to run its own checks.
 
     Raises:
-        SettingsError: an unknown key (with the nearest known one), a value of the wrong type,
-            or a value the agent rejects.
+        SettingsError: an unknown key (with the nearest known one), a value of the wrong type
+            (or an int beyond the float range for a float), or a value the agent rejects.
     """
     known = agent_settings(cls)
     config = deterministic_settings(cls, planner) if deterministic else {}
@@ -225,8 +231,10 @@ def build_agent_config(cls: type, planner: str, options: dict[str, Any],
         try:
             config[key] = _coerce(s.hint, value)
         except TypeError:
-            raise SettingsError.about("setting", f" {key}={value!r}: planner '{planner}' expects "
+            raise SettingsError.about("setting", f" {key}={shorten(value)}: planner '{planner}' expects "
                                 f"{s.type_name} (default {s.default!r})") from None
+        except NumberRefused as exc:
+            raise SettingsError.about("setting", f" {key}={shorten(value)}: {exc}") from None
     try:
         cls(**config)
     except (TypeError, ValueError) as exc:
