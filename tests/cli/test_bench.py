@@ -106,6 +106,8 @@ def test_bench_resume_flag_and_refusal(tmp_path, tiny, capsys):
     (["--planners", "straight", "--config", 'straight={"nope": 1}'],
      "--config straight: unknown setting of planner 'straight' 'nope'"),
     (["--planners", "straight", "--config", "straight=[1"], "--config straight: not JSON"),
+    (["--planners", "straight", "--config", f'straight={{"heading_gain": {"9" * 5000}}}'],
+     "--config straight: cannot read the JSON (a number with too many digits)"),  # was a ValueError
     (["--planners", "straight", "--config", "dovs={}"], "'dovs' is not in --planners"),
 ])
 def test_bench_bad_input_is_one_line(tmp_path, tiny, capsys, argv, message, monkeypatch):

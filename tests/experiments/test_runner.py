@@ -13,6 +13,7 @@ from anyplan.experiments.runner import (
     PlannerSpec,
     derive_seed,
     execute_task,
+    parse_planners,
     plan_tasks,
     run_bench,
 )
@@ -192,3 +193,13 @@ def test_a_library_config_is_checked_as_bench_config_is(tmp_path, tiny_file):
     with ResultsDB(tmp_path / "r.db", readonly=True) as db:
         (r,) = db.runs()
     assert r["settings"] == "align_tolerance = 3;heading_gain = 1.5;" and r["error"] is None
+
+
+@pytest.mark.parametrize(("blob", "why"), [
+    ('{"heading_gain": ' + "9" * 5000 + "}", "a number with too many digits"),  # int(): ValueError
+    ("[" * 100_000, "nested too deeply"),  # RecursionError
+])
+def test_a_config_json_python_cannot_hold_is_a_bench_error(blob, why):
+    with pytest.raises(BenchError) as info:
+        parse_planners("straight", [f"straight={blob}"])
+    assert str(info.value) == f"config straight: cannot read the JSON ({why})"

@@ -89,6 +89,9 @@ def parse_planners(text: str, configs: Sequence[str] = ()) -> list[PlannerSpec]:
             obj = json.loads(blob)
         except json.JSONDecodeError as exc:
             raise BenchError.about("config", f" {name}: not JSON ({exc.msg} at column {exc.colno})") from None
+        except (ValueError, RecursionError) as exc:  # an int of more than 4300 digits; [[[...
+            why = "nested too deeply" if isinstance(exc, RecursionError) else "a number with too many digits"
+            raise BenchError.about("config", f" {name}: cannot read the JSON ({why})") from None
         if not isinstance(obj, dict):
             raise BenchError.about("config", f" {name}: expected a JSON object like {{\"key\": 1}}")
         cfg.setdefault(name, {}).update(obj)
