@@ -15,6 +15,7 @@ class _Demo:
     mode: str = setting("a", choices=("a", "b"))
     flag: bool = setting(True)
     delays: tuple[float, ...] = setting((1.0,), lo=0.0, lo_open=True)
+    share: float = setting(0.5, lo=0.0, hi=1.0, hi_open=True)
 
     def __post_init__(self) -> None:
         validate(self)
@@ -29,11 +30,25 @@ class _Demo:
     ({"flag": 1}, "_Demo.flag: must be a bool, got 1"),
     ({"dt": float("nan")}, "_Demo.dt: must be a finite number, got nan"),
     ({"delays": (1.0, -1.0)}, "_Demo.delays: every item must be > 0, got -1.0"),
+    ({"share": 1.0}, "_Demo.share: must be in [0, 1), got 1.0"),
 ])
 def test_validate_names_the_class_and_the_field(kw, text):
     with pytest.raises(SettingError) as err:
         _Demo(**kw)
     assert str(err.value) == text and err.value.field == next(iter(kw))
+
+
+@pytest.mark.parametrize(("kw", "text"), [
+    ({"dt": 10**400}, "_Demo.dt: must be a finite number, got 1000"),
+    ({"n": -(10**400)}, "_Demo.n: must be a finite number, got -1000"),
+    ({"limit": 10**400}, "_Demo.limit: must be a finite number, got 1000"),
+    ({"delays": (1.0, 10**400)}, "_Demo.delays: every item must be a finite number, got 1000"),
+])
+def test_an_integer_beyond_the_float_range_is_refused_in_a_short_line(kw, text):
+    # math.isfinite raised an OverflowError here
+    with pytest.raises(SettingError) as err:
+        _Demo(**kw)
+    assert str(err.value).startswith(text) and len(str(err.value)) < 100
 
 
 def test_valid_values_pass_and_describe_lists_specs():

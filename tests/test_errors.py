@@ -54,6 +54,13 @@ def test_bounds_are_open_or_closed_below_and_closed_above(value, lo_open, hi, ou
         assert finite_float(value, 0.0, hi, lo_open=lo_open) == outcome
 
 
+def test_the_upper_bound_is_open_when_asked():
+    assert finite_float(1.0 - 1e-15, hi=1.0, hi_open=True) == 1.0 - 1e-15
+    with pytest.raises(NumberRefused, match=r"^must be < 1, got 1$") as info:
+        finite_float(1.0, hi=1.0, hi_open=True)
+    assert info.value.kind == "high"
+
+
 def test_the_reason_names_the_bound_and_shows_the_value():
     for kwargs, reason in (({"lo": 0.0, "lo_open": True}, "must be > 0, got -1"),
                            ({"lo": 0.5}, "must be >= 0.5, got -1"),

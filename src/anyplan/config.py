@@ -31,7 +31,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from anyplan.errors import AnyplanError
+from anyplan.errors import AnyplanError, NumberRefused, finite_float, shorten
 
 __all__ = ["SettingError", "Spec", "FieldInfo", "setting", "spec_of", "validate", "describe",
            "type_name"]
@@ -155,16 +155,17 @@ def _unit_range(spec: Spec) -> str:
 
 
 def _check_number(spec: Spec, value: Any, integer: bool) -> str | None:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        return f"must be a finite number, got {value!r}"
     lo, hi = spec.lo, spec.hi
-    bad = ((lo is not None and (value < lo or (spec.lo_open and value == lo)))
-           or (hi is not None and (value > hi or (spec.hi_open and value == hi))))
-    if not bad:
-        return None
-    unit = f" {spec.unit}" if spec.unit and lo is not None and hi is not None else ""
-    return f"must be {'an integer ' if integer and lo is not None and hi is not None else ''}" \
-           f"{spec.range_text()}{unit}, got {value!r}"
+    try:
+        finite_float(value, -math.inf if lo is None else lo, math.inf if hi is None else hi,
+                     lo_open=spec.lo_open, hi_open=spec.hi_open)
+    except NumberRefused as exc:
+        if exc.kind not in ("low", "high"):  # not a number, an int beyond the float range, nan, inf
+            return f"must be a finite number, got {shorten(value)}"
+        unit = f" {spec.unit}" if spec.unit and lo is not None and hi is not None else ""
+        return f"must be {'an integer ' if integer and lo is not None and hi is not None else ''}" \
+               f"{spec.range_text()}{unit}, got {shorten(value)}"
+    return None
 
 
 def validate(obj: Any, error: type[SettingError] = SettingError, owner: str | None = None) -> None:

@@ -63,9 +63,10 @@ class NumberRefused(ValueError):
 
 
 def finite_float(value: object, lo: float = -math.inf, hi: float = math.inf, *,
-                 lo_open: bool = False) -> float:
+                 lo_open: bool = False, hi_open: bool = False) -> float:
     """``value`` as a float when it is an int or float (not a bool), finite, >= ``lo`` (> ``lo``
-    with ``lo_open``) and <= ``hi``; the bounds are in the value's own unit.
+    with ``lo_open``) and <= ``hi`` (< ``hi`` with ``hi_open``); the bounds are in the value's
+    own unit.
 
     Raises:
         NumberRefused: anything else (its ``kind`` tells why, its message names no field).
@@ -97,8 +98,8 @@ def finite_float(value: object, lo: float = -math.inf, hi: float = math.inf, *,
         raise NumberRefused("nonfinite", f"must be finite, got {x:g}", f"{x:g}")
     if x < lo or (lo_open and x == lo):
         raise NumberRefused("low", f"must be {'>' if lo_open else '>='} {lo:g}, got {x:g}", f"{x:g}")
-    if x > hi:
-        raise NumberRefused("high", f"must be <= {hi:g}, got {x:g}", f"{x:g}")
+    if x > hi or (hi_open and x == hi):
+        raise NumberRefused("high", f"must be {'<' if hi_open else '<='} {hi:g}, got {x:g}", f"{x:g}")
     return x
 
 

@@ -28,6 +28,10 @@ def test_dovs_plot_at_time_zero(tmp_path) -> None:
     (["dovs-plot", "paper-1", "--time", "1", "--out", "x.gif"], ".png, .svg or .pdf"),
     (["dovs-plot", "paper-1", "--time", "1", "--set", "bogus=1"], "bogus"),
     (["dovs-plot", "paper-1", "--time", "1", "--set", "d_safe=-1"], "DOVSConfig.d_safe"),
+    (["dovs-plot", "paper-1", "--time", "1", "--set", "time_horizon_s=" + "9" * 400],
+     "DOVSConfig.time_horizon_s: must be a finite number, got 999"),  # an OverflowError before
+    (["dovs-plot", "paper-1", "--time", "1", "--set", "dw_samples=" + "9" * 400],
+     "DOVSConfig.dw_samples: must be a finite number, got 999"),
     (["dovs-plot", "no-such-scenario", "--time", "1"], "no-such-scenario"),
 ])
 def test_dovs_plot_bad_input(argv, needle, capsys, tmp_path, monkeypatch) -> None:

@@ -99,6 +99,19 @@ def test_a_set_value_python_cannot_convert_is_refused_by_name(tmp_path, scenario
     assert not out.exists() and not (tmp_path / "b.db").exists()
 
 
+@pytest.mark.parametrize(("planner", "key"), [("seq-bitstar", "batches_per_plan"),
+                                            ("dovs", "dw_samples")])
+def test_an_int_setting_beyond_the_float_range_is_refused_by_name(tmp_path, scenario, capsys, planner,
+                                                                  key):
+    # an int field of a settings dataclass (anyplan.config.validate): an OverflowError before
+    out = tmp_path / "r"
+    argv = ["run", str(scenario), "--planner", planner, "--out", str(out), "--no-plot"]
+    assert main([*argv, "--set", f"{key}={_HUGE}"]) == 2
+    _one_line(capsys, f"--set: planner '{planner}' rejects its settings: ", f"{key}: must be a finite "
+              "number, got 999")
+    assert not out.exists()
+
+
 def test_a_bench_config_int_beyond_the_float_range_is_refused_by_name(tmp_path, scenario, capsys):
     assert main(_bench(scenario, tmp_path, "--config", f'straight={{"heading_gain": {_HUGE}}}')) == 2
     _one_line(capsys, "--config straight: heading_gain=999", "number too large")
