@@ -249,6 +249,60 @@ def test_goal_bounds_equal_their_recurrence_bit_for_bit(seed):
         assert np.array_equal(got, want)
 
 
+@pytest.mark.parametrize("seed", range(10))
+def test_a_map_without_its_free_rows_gives_the_same_bounds_and_plans_bit_for_bit(seed):
+    # A long path's map is mostly rows after every prediction's end: they are not stored, and
+    # their goal-time bounds are computed in closed form (free_goal_time). On random maps, with
+    # reach both larger and smaller than a row's time allows (the closed form's two branches),
+    # every bound and every plan is the one the whole map gives.
+    from anyplan.trajectory.spacetime._lattice_kernels import free_goal_time, goal_times
+
+    rng = np.random.default_rng(700 + seed)
+    nrow, ncell = int(rng.integers(60, 200)), int(rng.integers(20, 90))
+    r_dense = int(rng.integers(0, nrow // 2))  # rows after it are free
+    forbidden = np.zeros((nrow, ncell), dtype=bool)
+    for _ in range(int(rng.integers(0, 10)) if r_dense else 0):
+        c, j = int(rng.integers(0, ncell - 2)), int(rng.integers(0, r_dense))
+        forbidden[j:min(j + int(rng.integers(1, 30)), r_dense), c:c + int(rng.integers(1, 6))] = True
+    c_goal = int(rng.integers(ncell // 2, ncell))
+    reach = int(rng.integers(1, 5))
+    t_map, h, ds, v_max = float(rng.uniform(-0.05, 2.0)), 0.05, 0.05, float(rng.uniform(0.5, 4.0))
+    for c_first in (-1, int(rng.integers(0, 4))):
+        full = goal_times(forbidden, t_map, h, c_goal, reach, ds, v_max, c_first)
+        cut = goal_times(forbidden[:r_dense], t_map, h, c_goal, reach, ds, v_max, c_first, nrow)
+        assert cut.shape == (r_dense + 1, ncell)
+        assert np.array_equal(cut, full[:r_dense + 1])
+        for j in range(r_dense, nrow + 1):
+            computed = ncell if c_first < 0 else min(ncell, c_first + j * reach + 1)
+            for c in range(computed if j < nrow else ncell):
+                got = free_goal_time(j, c, t_map, h, c_goal, reach, ds, v_max, nrow)
+                assert got == full[j, c], (j, c)
+    # the planner on the map without its free rows: the same plan
+    length = float(rng.uniform(1.0, 4.0))
+    x0, x1 = _caps(length)
+    forbidden = np.zeros((nrow, len(x0)), dtype=bool)
+    for _ in range(int(rng.integers(1, 6)) if r_dense else 0):
+        c, j = int(rng.integers(3, len(x0) - 3)), int(rng.integers(0, r_dense))
+        forbidden[j:min(j + int(rng.integers(5, 40)), r_dense), c:c + int(rng.integers(1, 6))] = True
+    v0 = 0.0 if seed % 3 == 0 else float(rng.uniform(0.0, V))
+    for key in (0, 4):
+        a = plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, v0, A, V, key_cells=key,
+                          horizon_s=nrow * H)
+        b = plan_velocity(forbidden[:r_dense], 0.0, H, DS, x0, x1, length, 0.0, v0, A, V,
+                          key_cells=key, horizon_s=nrow * H, rows=nrow)
+        assert (a is None) == (b is None)
+        if a is not None and b is not None:
+            for f in ("t", "s", "v", "a"):
+                assert np.array_equal(getattr(a, f), getattr(b, f))
+
+
+def test_a_map_cannot_claim_fewer_rows_than_it_holds():
+    x0, x1 = _caps(2.0)
+    with pytest.raises(ValueError, match="rows: 10 is fewer than the map's 20"):
+        plan_velocity(np.zeros((20, len(x0)), dtype=bool), 0.0, H, DS, x0, x1, 2.0, 0.0, 0.0, A, V,
+                      rows=10)
+
+
 @pytest.mark.parametrize("a_max", [0.001, 1000.0])
 def test_a_robot_at_the_schemas_acceleration_limits_gets_a_bounded_lattice(a_max):
     # a_max = 0.001 made 1600 speed levels and a_max = 1000 a step of 0.2 ms: the search's

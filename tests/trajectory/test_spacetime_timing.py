@@ -230,10 +230,14 @@ def test_a_prediction_that_ends_marks_nothing_after_its_end(cached):
         ends = build_stmap(_pts, 8.0, [PredictedObstacle("S", 0.3, motion, until=until)],
                            SPEC.radius, 0.0, 20.0, margin=0.05, rows=rows)
         j_end = int(until / ends.h)  # the row that contains the end still has the disc
-        assert np.array_equal(ends.forbidden[:j_end + 1], endless.forbidden[:j_end + 1])
-        assert endless.forbidden[:j_end + 1].any(axis=1).all()
-        assert not ends.forbidden[j_end + 1:].any()
-        assert endless.forbidden[j_end + 1:].any(axis=1).all()
+        g_ends, g_endless = ends.grid(), endless.grid()
+        assert ends.rows == endless.rows == g_ends.shape[0]
+        assert np.array_equal(g_ends[:j_end + 1], g_endless[:j_end + 1])
+        assert g_endless[:j_end + 1].any(axis=1).all()
+        assert not g_ends[j_end + 1:].any()
+        assert g_endless[j_end + 1:].any(axis=1).all()
+        # the rows after the end are not stored: the map holds the end's row and the next
+        assert ends.forbidden.shape[0] == j_end + 2 < ends.rows
 
 
 def test_rows_of_one_motion_are_shared_whatever_its_predictions_end():
@@ -300,9 +304,11 @@ def test_rows_after_every_predictions_end_are_free_and_the_rest_as_computed_in_f
         cut = build_stmap(_pts, 8.0, obs, SPEC.radius, 1.25, 25.0, margin=0.05, rows=rows)
         full = build_stmap(_pts, 8.0, [*obs, far], SPEC.radius, 1.25, 25.0, margin=0.05,
                            rows=None if rows is None else RowCache(1.0, 0.05))
-        assert np.array_equal(cut.forbidden, full.forbidden) and cut.forbidden.any()
-        starts = cut.t_map + cut.h * np.arange(cut.forbidden.shape[0])
-        assert not cut.forbidden[starts > last].any() and (starts > last).sum() > 100
+        assert np.array_equal(cut.grid(), full.grid()) and cut.forbidden.any()
+        starts = cut.t_map + cut.h * np.arange(cut.rows)
+        assert not cut.grid()[starts > last].any() and (starts > last).sum() > 100
+        # and only the rows up to the last end are stored
+        assert cut.forbidden.shape[0] <= (starts <= last).sum() + 1 < full.forbidden.shape[0]
 
 
 def test_a_map_beyond_its_bound_gets_wider_cells_and_the_timing_stays_free(monkeypatch):

@@ -344,7 +344,7 @@ def _stmap() -> None:
     caps = np.full(st.forbidden.shape[1], 1.0)
     for v0 in (0.0, 0.3):  # on the lattice's speed levels, and between two (its first step)
         plan_velocity(st.forbidden, st.t_map, st.h, st.ds, caps, caps, length, 0.0, v0, 0.5, 1.0,
-                      horizon_s=8.0)
+                      horizon_s=8.0, rows=st.rows)
     provably_disconnected(ObstacleSet([], bounds=(0.0, 0.0, 4.0, 2.0)), (0.5, 0.5), (3.5, 0.5),
                           0.2)
 

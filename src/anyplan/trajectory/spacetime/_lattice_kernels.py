@@ -14,11 +14,13 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-__all__ = ["LatticeMap", "edge_ok", "goal_times", "search", "to_go"]
+__all__ = ["LatticeMap", "edge_ok", "free_goal_time", "goal_times", "search", "to_go"]
 
 
 class LatticeMap(NamedTuple):
-    """The s-t map and speed caps one search runs on (fields as in ``plan_velocity``)."""
+    """The s-t map and speed caps one search runs on (fields as in ``plan_velocity``):
+    ``forbidden`` holds the map's first rows, ``nrow`` >= its row count is the map's length in
+    rows; the rows beyond ``forbidden``'s are free."""
 
     forbidden: np.ndarray
     t_map: float
@@ -26,15 +28,21 @@ class LatticeMap(NamedTuple):
     ds: float
     xcap0: np.ndarray
     xcap1: np.ndarray
+    nrow: int
 
 
 @njit(cache=True)
 def edge_ok(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap0: np.ndarray,
-            xcap1: np.ndarray, t_a: float, s_a: float, v_a: float, acc: float, dur: float) -> bool:
+            xcap1: np.ndarray, t_a: float, s_a: float, v_a: float, acc: float, dur: float,
+            nrow: int = -1) -> bool:
     """True if the step from (t_a, s_a, v_a) with acceleration ``acc`` for ``dur`` seconds keeps
-    the speed limit and touches no forbidden cell (rows beyond the map count as forbidden)."""
+    the speed limit and touches no forbidden cell (rows beyond the map count as forbidden).
+    ``nrow``: the map's rows, of which ``forbidden`` holds the first (the others are free);
+    -1: ``forbidden`` holds them all."""
     ncell = forbidden.shape[1]
-    nrow = forbidden.shape[0]
+    n_dense = forbidden.shape[0]
+    if nrow < 0:
+        nrow = n_dense
     s_b = s_a + v_a * dur + 0.5 * acc * dur * dur
     v_b = v_a + acc * dur
     if v_b < -1e-9:
@@ -53,7 +61,7 @@ def edge_ok(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap0: np.
         j0 = 0
     if j1 >= nrow:
         return False
-    for j in range(j0, j1 + 1):
+    for j in range(j0, min(j1 + 1, n_dense)):
         ta = max(t_a, t_map + j * h) - t_a
         tb = min(t_a + dur, t_map + (j + 1) * h) - t_a
         sa = s_a + v_a * ta + 0.5 * acc * ta * ta
@@ -81,8 +89,36 @@ def to_go(d: float, v: float, a: float, v_max: float) -> float:
 
 
 @njit(cache=True)
+def free_goal_time(j: int, c: int, t_map: float, h: float, c_goal: int, reach: int, ds: float,
+                   v_max: float, nrow: int) -> float:
+    """:func:`goal_times`' bound G[j, c] when every row from j on is free (j <= ``nrow``, the
+    map's rows; row ``nrow`` is the one after the map): its recurrence in closed form.
+
+    From c < c_goal the relaxed robot advances ``reach`` cells a row, so the goal is reached in
+    the row k - 1 rows on, k = ceil((c_goal - c) / reach), if the map has it (else inf); the
+    bound is the largest of the rows' distance bounds t_{j+i} + (c_goal - c_i - 1) ds / v_max
+    along the way, at its first row when a row's advance outruns its time (reach ds / v_max > h,
+    as :func:`~anyplan.trajectory.spacetime.lattice.plan_velocity`'s reach does), else each term
+    is computed: bit for bit the recurrence's value, each term computed as it does."""
+    tj = t_map + j * h
+    if c >= c_goal:
+        return tj
+    k = (c_goal - c + reach - 1) // reach
+    if j + k - 1 >= nrow:
+        return np.inf
+    best = tj + (c_goal - c - 1) * ds / v_max
+    slope = reach * ds / v_max - h  # how much faster each next term falls than time grows
+    if slope > 1e-9 * (1.0 + abs(t_map) + nrow * h):
+        return best
+    for i in range(1, k):
+        ci = c + i * reach
+        best = max(best, (t_map + (j + i) * h) + (c_goal - ci - 1) * ds / v_max)
+    return best
+
+
+@njit(cache=True)
 def goal_times(forbidden: np.ndarray, t_map: float, h: float, c_goal: int, reach: int,
-               ds: float, v_max: float, c_first: int = -1) -> np.ndarray:
+               ds: float, v_max: float, c_first: int = -1, nrow: int = -1) -> np.ndarray:
     """Lower bounds G[j, c] [s] on the arrival at the goal cell from cell c at time t_map + j h.
 
     The relaxation of every lattice motion: within a row the robot advances by at most ``reach``
@@ -91,23 +127,36 @@ def goal_times(forbidden: np.ndarray, t_map: float, h: float, c_goal: int, reach
     (the max of two lower bounds is one). Backward over the rows; inf marks cells from which the
     goal cannot be reached within the map (the search drops them).
 
+    ``nrow``: the map's rows, of which ``forbidden`` holds the first R (the others are free; -1:
+    it holds them all). The table returned has R + 1 rows: the bounds of rows 0 .. R - 1, then
+    those of row R (the row after the map when R = ``nrow``); the rows after R are
+    :func:`free_goal_time`'s. A long path's map, whose predictions end within seconds, so costs
+    what the rows of the predictions cost, not its whole duration.
+
     With ``c_first >= 0`` only the cells c <= c_first + j reach of row j are computed (the others
     stay inf): row j reads row j + 1 up to c + reach only, so the computed cells get the same
     values; :func:`~anyplan.trajectory.spacetime.lattice.plan_velocity` passes a c_first beyond
     every cell a motion from the start can be in during row 0 (then during row j too, as
     v_max h / ds < reach): the search reads no other cell.
     """
-    nrow, ncell = forbidden.shape
-    g = np.full((nrow + 1, ncell), np.inf)
-    for c in range(c_goal, ncell):
-        g[nrow, c] = t_map + nrow * h
+    n_dense, ncell = forbidden.shape
+    if nrow < 0:
+        nrow = n_dense
+    g = np.full((n_dense + 1, ncell), np.inf)
+    if n_dense == nrow:
+        for c in range(c_goal, ncell):
+            g[nrow, c] = t_map + nrow * h
+    else:
+        c_end = ncell if c_first < 0 else min(ncell, c_first + n_dense * reach + 1)
+        for c in range(c_end):
+            g[n_dense, c] = free_goal_time(n_dense, c, t_map, h, c_goal, reach, ds, v_max, nrow)
     # While every row from j + 1 on is free, row j + 1 is nonincreasing in c (the last row is:
     # inf, then the goal time; a free row's window minima of a nonincreasing row are the
     # window ends, and the distance bound decreases in c), so the minimum over a window is its
     # last cell: the same value as the scan below, read once. Obstacles are predicted over a
     # few seconds and the map runs to the arrival, so most rows are such a free suffix.
     suffix = True
-    for j in range(nrow - 1, -1, -1):
+    for j in range(n_dense - 1, -1, -1):
         tj = t_map + j * h
         c_end = ncell if c_first < 0 else min(ncell, c_first + j * reach + 1)
         if suffix:
@@ -145,9 +194,12 @@ def goal_times(forbidden: np.ndarray, t_map: float, h: float, c_goal: int, reach
 
 @njit(cache=True)
 def search(lm: LatticeMap, gt: np.ndarray, t_a: float, s_a: float, k_a: int, a: float, dt: float,
-           kmax: int, m_goal: int, n_max: int, key_cells: int, t_cap: float) -> np.ndarray:
+           kmax: int, m_goal: int, n_max: int, key_cells: int, t_cap: float, c_goal: int,
+           reach: int, v_max: float) -> np.ndarray:
     """A* over lattice nodes (step n, m, k), cost = time, heuristic = the larger of the
-    obstacle-free time to go and the relaxed bound ``gt`` of :func:`goal_times` (both admissible);
+    obstacle-free time to go and the relaxed bound of :func:`goal_times` (both admissible:
+    its table ``gt``, computed with ``c_goal``, ``reach`` and ``v_max``, then
+    :func:`free_goal_time` on the rows after it);
     returns the accelerations (-1, 0, 1) of the earliest motion from
     (m=0, k=k_a) at t_a to (m_goal, 0), or [-9] if none within n_max steps.
 
@@ -165,6 +217,7 @@ def search(lm: LatticeMap, gt: np.ndarray, t_a: float, s_a: float, k_a: int, a: 
     in time, so the full search would end without a motion too.
     """
     forbidden, t_map, h, ds, xcap0, xcap1 = lm.forbidden, lm.t_map, lm.h, lm.ds, lm.xcap0, lm.xcap1
+    nrow = lm.nrow
     delta = 0.5 * a * dt * dt
     vstep = a * dt
     nm = m_goal + 1
@@ -199,12 +252,14 @@ def search(lm: LatticeMap, gt: np.ndarray, t_a: float, s_a: float, k_a: int, a: 
             key = min(int((s_a + m2 * delta) / (max(key_cells, 1) * ds)), ncell - 1)
             if key_cells > 0 and seen[n + 1, key, k2] and m2 != m_goal:
                 continue
-            if not edge_ok(forbidden, t_map, h, ds, xcap0, xcap1, t, s, v, u * a, dt):
+            if not edge_ok(forbidden, t_map, h, ds, xcap0, xcap1, t, s, v, u * a, dt, nrow):
                 continue
             s2 = s_a + m2 * delta
             t2 = t + dt
-            j2 = min(max(int((t2 - t_map) / h + 1e-9), 0), gt.shape[0] - 1)
-            g2 = gt[j2, min(max(int(s2 / ds), 0), ncell - 1)]
+            j2 = min(max(int((t2 - t_map) / h + 1e-9), 0), nrow)
+            c2 = min(max(int(s2 / ds), 0), ncell - 1)
+            g2 = (gt[j2, c2] if j2 < gt.shape[0] else
+                  free_goal_time(j2, c2, t_map, h, c_goal, reach, ds, v_max, nrow))
             if g2 == np.inf:
                 continue  # the goal cannot be reached from there within the map
             parent[n + 1, m2, k2] = u + 2

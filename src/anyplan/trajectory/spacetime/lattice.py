@@ -109,8 +109,8 @@ def bounded_lattice(v_max: float, a_max: float, target_dt: float, horizon_s: flo
 def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap0: np.ndarray,
                   xcap1: np.ndarray, length: float, t0: float, v0: float, a_max: float,
                   v_max: float, *, target_dt: float = 0.25, horizon_s: float = 60.0,
-                  key_cells: int = 4, cap: bool = True, frontier: bool = True
-                  ) -> VelocityPlan | None:
+                  key_cells: int = 4, cap: bool = True, frontier: bool = True,
+                  rows: int | None = None) -> VelocityPlan | None:
     """The earliest lattice motion from (t0, s=0, v0) to rest at (about) the path's end.
 
     Args:
@@ -137,11 +137,17 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
             sooner; False runs it to exhaustion, for tests).
         frontier: Compute the goal-time bounds only on the cells a motion from the start can
             reach (the same answer, sooner; False computes every cell, for tests).
+        rows: The map's rows, of which ``forbidden`` holds the first (the rows after them are
+            free: :class:`~anyplan.trajectory.spacetime.STMap` keeps only the rows its
+            predictions reach); None: ``forbidden`` holds them all.
 
     Returns:
         The :class:`VelocityPlan`, or None if no lattice motion reaches the end in the horizon.
     """
     ncell = forbidden.shape[1]
+    nrow = forbidden.shape[0] if rows is None else int(rows)
+    if nrow < forbidden.shape[0]:
+        raise ValueError(f"rows: {nrow} is fewer than the map's {forbidden.shape[0]}")
     dt, kmax, a_max = bounded_lattice(v_max, a_max, target_dt, horizon_s, length, ncell)
     vstep = a_max * dt
     delta = 0.5 * a_max * dt * dt
@@ -158,18 +164,18 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
             if k > kmax:
                 continue
             tau = abs(k * vstep - v0) / a_max
-            if not edge_ok(forbidden, t_map, h, ds, xcap0, xcap1, t0, 0.0, v0, acc, tau):
+            if not edge_ok(forbidden, t_map, h, ds, xcap0, xcap1, t0, 0.0, v0, acc, tau, nrow):
                 continue
             starts.append((t0 + tau, v0 * tau + 0.5 * acc * tau * tau, k, acc, tau))
     c_goal = min(int(math.floor((length - 2.0 * delta) / ds)), ncell - 1)
     reach = int(math.ceil(v_max * h / ds)) + 1
-    lm = LatticeMap(forbidden, float(t_map), float(h), float(ds), xcap0, xcap1)
+    lm = LatticeMap(forbidden, float(t_map), float(h), float(ds), xcap0, xcap1, nrow)
     # A motion from (t0, s = 0) is at s <= v_max (t - t0): during row j (t < t_map + (j+1) h)
     # in a cell <= c_first + j (v_max h / ds) (2 cells to spare for rounding); goal_times
     # computes only the cells the search can read (the same values there).
     c_first = max(int(v_max * (t_map + h - t0) / ds) + 2, 0) if frontier else -1
     gt = goal_times(forbidden, float(t_map), float(h), max(c_goal, 0), reach, float(ds),
-                    float(v_max), c_first)
+                    float(v_max), c_first, nrow)
     best: VelocityPlan | None = None
     for t_a, s_a, k_a, acc0, tau0 in starts:
         m_goal = int(math.floor((length - s_a) / delta + 1e-9))
@@ -181,7 +187,8 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
         # rounding) ends a search that cannot succeed, with the same answer (see search).
         acts = search(lm, gt, float(t_a), float(s_a), int(k_a), float(a_max), float(dt),
                       int(kmax), int(m_goal), n_max, int(key_cells),
-                      float(t_a) + n_max * float(dt) + 1e-6 if cap else math.inf)
+                      float(t_a) + n_max * float(dt) + 1e-6 if cap else math.inf,
+                      max(c_goal, 0), reach, float(v_max))
         if len(acts) == 1 and acts[0] == -9:
             continue
         ks = np.concatenate([[k_a], k_a + np.cumsum(acts)])

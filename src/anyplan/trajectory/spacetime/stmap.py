@@ -244,7 +244,10 @@ class STMap:
     """A boolean s-t map (see the module docstring).
 
     Attributes:
-        forbidden: (rows, cells) boolean array.
+        forbidden: (R, cells) boolean array: the map's first R rows, those the predictions may
+            mark; its other rows are free (not stored: a long path's map, whose predictions
+            end within seconds, costs what those seconds cost).
+        rows: The map's rows (>= R).
         t_map: Time [s] of the first row's start.
         h: Row duration [s].
         ds: Cell width [m].
@@ -253,15 +256,25 @@ class STMap:
     """
 
     def __init__(self, forbidden: np.ndarray, t_map: float, h: float, ds: float, length: float,
-                 blockers: list[str]) -> None:
+                 blockers: list[str], rows: int | None = None) -> None:
         self.forbidden = forbidden
+        self.rows = forbidden.shape[0] if rows is None else int(rows)
+        if self.rows < forbidden.shape[0]:
+            raise ValueError(f"rows: {self.rows} is fewer than the stored {forbidden.shape[0]}")
         self.t_map, self.h, self.ds, self.length = float(t_map), float(h), float(ds), float(length)
         self.blockers = blockers
 
     @property
     def horizon_s(self) -> float:
         """Duration [s] covered by the rows."""
-        return self.forbidden.shape[0] * self.h
+        return self.rows * self.h
+
+    def grid(self) -> np.ndarray:
+        """The whole map, (rows, cells) boolean, its free rows included (for tests and
+        pictures; the planner reads :attr:`forbidden` and :attr:`rows`)."""
+        out = np.zeros((self.rows, self.forbidden.shape[1]), dtype=np.bool_)
+        out[: self.forbidden.shape[0]] = self.forbidden
+        return out
 
 
 def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_radius: float,
@@ -294,7 +307,6 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
         horizon_s = t_end - t_map
     ncell = max(1, int(math.ceil(length / ds)))
     nrow = max(1, int(math.ceil(horizon_s / h)))
-    out = np.zeros((nrow, ncell), dtype=np.bool_)
     sc = np.minimum((np.arange(ncell) + 0.5) * ds, length)
     p = np.asarray(points_at(sc), dtype=float).reshape(-1, 2)
     px, py = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
@@ -306,10 +318,11 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     obstacles = list(obstacles)
     blockers: list[str] = []
     if not obstacles:
-        return STMap(out, t_map, h, ds, length, blockers)
-    # Rows that start after every prediction's end hold no disc: they stay free, uncomputed.
+        return STMap(np.zeros((0, ncell), dtype=np.bool_), t_map, h, ds, length, blockers, nrow)
+    # Rows that start after every prediction's end hold no disc: they stay free, not stored.
     ends = max(float(getattr(o, "until", math.inf)) for o in obstacles)
     nfill = nrow if ends == math.inf else max(1, min(nrow, int(math.floor((ends - t_map) / h)) + 2))
+    out = np.zeros((nfill, ncell), dtype=np.bool_)
     if rows is not None:
         qx, qy, r_max = rows.rows_all(obstacles, j_first, j_first + nfill)
     else:
@@ -326,8 +339,8 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     away = np.min(np.hypot(qx - gx, qy - gy) - grad - reach, axis=1) > 0.0  # never near the path
     near = np.flatnonzero(~away)
     if len(near):
-        hit = _fill(out[:nfill], px, py, cx, cy, crad, np.ascontiguousarray(qx[near]),
+        hit = _fill(out, px, py, cx, cy, crad, np.ascontiguousarray(qx[near]),
                     np.ascontiguousarray(qy[near]), np.ascontiguousarray(reach[near]),
                     speed[near] * h, _CHUNK, n_free, sx, sy, srad, _GROUP)
         blockers = [str(obstacles[k].name) for k, hh in zip(near, hit, strict=True) if hh]
-    return STMap(out, t_map, h, ds, length, blockers)
+    return STMap(out, t_map, h, ds, length, blockers, nrow)

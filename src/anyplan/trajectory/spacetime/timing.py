@@ -34,9 +34,11 @@ from anyplan.world.robot import RobotSpec
 __all__ = ["TimedCurveSegment", "speed_caps", "retime", "verify", "RetimeResult", "map_ds",
            "MAX_MAP_CELLS"]
 
-#: Largest s-t map of a re-timing, in cells (rows x columns; with the goal-time bounds, nine
-#: bytes each). The built-in, generated and benchmark scenarios need below 10^7 (the paper's
-#: robot on a 30 m path: 1.3 x 10^6); a 1 km path asked for 10^9 (13 GB) (:func:`map_ds`).
+#: Largest s-t map of a re-timing, in cells (rows x columns, counting the rows after every
+#: prediction's end, which are not stored: the stored rows take nine bytes a cell with their
+#: goal-time bounds). The built-in, generated and benchmark scenarios need below 10^7 (the
+#: paper's robot on a 30 m path: 1.3 x 10^6); a 1 km path asked for 10^9 (13 GB when every row
+#: was stored) (:func:`map_ds`).
 MAX_MAP_CELLS = 2 ** 25
 
 
@@ -174,7 +176,8 @@ def retime(traj: Trajectory, obstacles: Sequence[Any], spec: RobotSpec, *, margi
     x0, x1 = speed_caps(seg.profile, spec, ds, stmap.forbidden.shape[1])
     v0 = float(seg.profile.v[0])
     plan = plan_velocity(stmap.forbidden, stmap.t_map, stmap.h, ds, x0, x1, length, seg.t0, v0,
-                         spec.a_max, spec.v_max, target_dt=target_dt, horizon_s=horizon)
+                         spec.a_max, spec.v_max, target_dt=target_dt, horizon_s=horizon,
+                         rows=stmap.rows)
     if plan is None:
         return RetimeResult(None, None, stmap, nominal)
     new = Trajectory(list(segs[:-1]) + [TimedCurveSegment(curve, plan)], kind=ST_PREFIX + traj.kind,
