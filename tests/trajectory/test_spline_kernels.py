@@ -118,6 +118,29 @@ def test_branch_and_bound_finds_the_same_worst_pieces(seed):
             assert bmargin == margin
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_branch_and_bound_on_a_long_curve_out_of_its_arena_finds_the_same_worst_pieces(seed):
+    # A long path's first spline swings metres out of a narrow arena: thousands of buried
+    # pieces, whose leaves the bound made for distances (its slack grows with the coordinates)
+    # could not prune, 4^4 leaves each; the bound for buried pieces prunes them. Same answers.
+    rng = np.random.default_rng(40 + seed)
+    xs = np.concatenate([[0.0, rng.uniform(2.0, 4.0)], np.sort(rng.uniform(20.0, 140.0, 2)), [150.0]])
+    ys = np.array([0.0, rng.choice([-1.0, 1.0]) * rng.uniform(1.0, 2.0), 0.0, rng.uniform(-0.5, 0.5), 0.0])
+    pts = np.column_stack([xs + 400.0 * (seed % 2), ys])  # far from the origin: a large slack
+    # a sharp first turn, then long segments: the spline swings up to 17 m off the line
+    c = SmoothCurve(pts, start_heading=float(-np.sign(ys[1]) * rng.uniform(0.5, 1.2)), grid_step=0.05)
+    obs = ObstacleSet([Circle((pts[2, 0], 1.5), 0.5)], bounds=(pts[0, 0] - 1.0, -2.5,
+                                                             pts[-1, 0] + 1.0, 2.5))
+    off = np.abs(c.position(np.linspace(0.0, c.knots[-1], 5000))[:, 1]) > 2.5 + 0.3
+    assert off.mean() > 0.2  # a quarter to a half of the curve is out of the arena
+    for radius in (0.1, 0.3):
+        kk, fu, fc, margin = failing_pieces(c, obs, radius, 4)
+        ks, bu, bc, bmargin = worst_failures(c, obs, radius, 4)
+        assert _reduce(kk, fu, fc) == (ks.tolist(), bu.tolist(), bc.tolist())
+        if len(kk) == 0:
+            assert bmargin == margin
+
+
 @pytest.mark.parametrize("seed", range(16))
 def test_branch_and_bound_on_maps_finds_the_same_worst_pieces(seed):
     # The same on a map: curves through walls (buried pieces: no clearance queries below them),

@@ -71,6 +71,39 @@ def chord_dev_one(x: np.ndarray, c: np.ndarray, a_u: float, b_u: float,
 
 
 @njit(cache=True)
+def leaf_dev_bound(x: np.ndarray, c: np.ndarray, a_u: float, b_u: float, levels: int) -> float:
+    """An upper bound [m] on the deviation bound :func:`chord_dev_one` computes for each piece
+    that ``levels`` 4-way splits of [a_u, b_u] make, its rounding included (inf when the piece
+    is not inside one cubic).
+
+    r'' is affine on a cubic, so |r''| is convex and at most its larger end value on the whole
+    piece; a sub-piece is 4^-levels as long. Allowed for: the sub-pieces' ends and their t off
+    by a few ulp a split (and the last one's end just past b_u), r'' evaluated to a few ulp of
+    its terms' size, the products to a few ulp: each by far more than rounding can give."""
+    xe = x[-1]
+    a = min(max(a_u, 0.0), xe)
+    b = min(max(b_u, 0.0), xe)
+    bi = min(max(b_u - 1e-12 * max(1.0, abs(b_u)), 0.0), xe)
+    i = locate(x, a, np.int64(0))
+    if locate(x, bi, i) != i:
+        return np.inf
+    ta = a - x[i]
+    tb = b - x[i]
+    c2x = c[i, 2, 0]
+    c2y = c[i, 2, 1]
+    c3x = c[i, 3, 0]
+    c3y = c[i, 3, 1]
+    ma = math.hypot(2.0 * c2x + 6.0 * ta * c3x, 2.0 * c2y + 6.0 * ta * c3y)
+    mb = math.hypot(2.0 * c2x + 6.0 * tb * c3x, 2.0 * c2y + 6.0 * tb * c3y)
+    g3 = 6.0 * math.hypot(c3x, c3y)  # the third derivative's size: how fast |r''| can change
+    size = 2.0 * math.hypot(c2x, c2y) + g3 * max(abs(ta), abs(tb))
+    stray = 4.0 * (levels + 2) * 2.3e-16 * max(1.0, abs(a_u), abs(b_u), abs(xe))
+    m = max(ma, mb) + 1e-12 * size + g3 * stray
+    h = (b_u - a_u) / 4.0 ** levels * (1.0 + 1e-12) + stray
+    return m * h * h / 8.0 * (1.0 + 1e-12)
+
+
+@njit(cache=True)
 def chord_deviation(x: np.ndarray, c: np.ndarray, a_u: np.ndarray,
                     b_u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For pieces [a_u, b_u] (within one cubic): end points (N, 2) each and the bound
@@ -340,6 +373,11 @@ def certify_worst(cv: CurveArrays, limit: float, radius: float, max_depth: int,
             # chord clearances are >= 0: the sub-pieces' certified clearances are
             # >= max(clr(P), 0) - dev(P) / 16^levels
             if has[kj] and max(cj, 0.0) - sv[top] / 16.0 ** (max_depth - depth) - slack >= best_c[kj]:
+                continue
+            # a buried piece's leaves are all -dev (no distance is computed, so no slack of the
+            # coordinates' size): the bound above, made for distances, keeps every such piece
+            # of a curve far outside the arena (4^depth leaves each); this one does not
+            if buried and has[kj] and -leaf_dev_bound(x, c, a, b, max_depth - depth) > best_c[kj]:
                 continue
             w = b - a
             n_c = 0
