@@ -161,3 +161,31 @@ def test_both_repair_modes_certify(mode, world_factory):
     res = smooth_path(path, obs, spec.radius, repair=mode)
     assert res.curve is not None
     assert dense_min_clearance(res.curve, obs, 100_000) >= spec.radius - 1e-9
+
+
+def test_a_long_path_is_fitted_over_segments_of_at_most_max_segment():
+    # A 600 m corridor path with a sharp first turn: the spline through its five points swung
+    # 15 m out of the 12 m corridor, and the repair certified all 600 m round after round.
+    # Over segments of at most MAX_SEGMENT_M the first fit stays in the corridor and is
+    # certified at once; the points added lie on the polyline (the route is unchanged).
+    from anyplan.trajectory.spline.smooth import MAX_SEGMENT_M, split_long_segments
+
+    path = np.array([[0.0, 0.0], [3.3, 1.5], [95.0, 0.0], [132.7, 1.0], [596.0, 0.0]])
+    dense = split_long_segments(path, MAX_SEGMENT_M)
+    seg = np.hypot(*np.diff(dense, axis=0).T)
+    assert seg.max() <= MAX_SEGMENT_M + 1e-9 and len(dense) > len(path)
+    for p in path:  # every original point kept, in order
+        assert np.any(np.all(dense == p, axis=1))
+    for a, b in zip(path[:-1], path[1:], strict=True):  # every added point on its segment
+        inside = [q for q in dense if 0.0 < np.dot(q - a, b - a) < np.dot(b - a, b - a)]
+        for q in inside:
+            u, w = b - a, q - a
+            assert abs(u[0] * w[1] - u[1] * w[0]) <= 1e-9 * np.dot(u, u)
+    obs = ObstacleSet([], bounds=(-1.0, -6.0, 597.0, 6.0))
+    res = smooth_path(path, obs, 0.35, start_heading=-0.9)
+    assert res.curve is not None and res.rounds == 0
+    y = res.curve.position(np.linspace(0.0, res.curve.knots[-1], 20_000))[:, 1]
+    assert np.abs(y).max() < 6.0 - 0.35
+    # below the bound nothing is split: the arenas' paths are fitted as before
+    short = np.array([[0.0, 0.0], [20.0, 3.0], [24.0, -1.0]])
+    assert split_long_segments(short, MAX_SEGMENT_M) is short
