@@ -296,6 +296,28 @@ def test_a_map_without_its_free_rows_gives_the_same_bounds_and_plans_bit_for_bit
                 assert np.array_equal(getattr(a, f), getattr(b, f))
 
 
+@pytest.mark.parametrize("seed", range(12))
+def test_the_search_kept_in_hash_tables_finds_the_same_plans(seed):
+    # A large lattice keeps its search's marks in hash tables, not dense arrays (a long path's
+    # arrays were hundreds of MB, zeroed each search): on random maps, with coarse keys and
+    # without, from speeds off the lattice, the plans are the dense arrays' bit for bit.
+    rng = np.random.default_rng(900 + seed)
+    length = float(rng.uniform(1.0, 5.0))
+    x0, x1 = _caps(length)
+    forbidden = np.zeros((int(rng.integers(150, 400)), len(x0)), dtype=bool)
+    for _ in range(int(rng.integers(0, 10))):
+        c, j = rng.integers(3, len(x0) - 3), rng.integers(0, forbidden.shape[0] - 10)
+        forbidden[j:j + rng.integers(5, 120), c:c + rng.integers(1, 8)] = True
+    v0 = 0.0 if seed % 3 == 0 else float(rng.uniform(0.0, V))
+    for key in (0, 4):
+        a, b = (plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, v0, A, V, key_cells=key,
+                              horizon_s=forbidden.shape[0] * H, dense_cells=d) for d in (None, 0))
+        assert (a is None) == (b is None)
+        if a is not None and b is not None:
+            for f in ("t", "s", "v", "a"):
+                assert np.array_equal(getattr(a, f), getattr(b, f))
+
+
 def test_a_map_cannot_claim_fewer_rows_than_it_holds():
     x0, x1 = _caps(2.0)
     with pytest.raises(ValueError, match="rows: 10 is fewer than the map's 20"):

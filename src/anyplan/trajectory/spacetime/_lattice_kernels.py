@@ -14,7 +14,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-__all__ = ["LatticeMap", "edge_ok", "free_goal_time", "goal_times", "search", "to_go"]
+__all__ = ["DENSE_CELLS", "LatticeMap", "edge_ok", "free_goal_time", "goal_times", "search", "to_go"]
 
 
 class LatticeMap(NamedTuple):
@@ -192,16 +192,50 @@ def goal_times(forbidden: np.ndarray, t_map: float, h: float, c_goal: int, reach
     return g
 
 
+#: Largest lattice (steps x max(positions, map cells) x speeds) whose search keeps its marks in
+#: dense arrays (allocated and zeroed each search: about a millisecond at this size); larger
+#: ones keep them in hash tables (:func:`_probe`), whose cost follows the nodes reached.
+DENSE_CELLS = 2 ** 22
+
+
+@njit(cache=True)
+def _probe(keys: np.ndarray, key: int) -> int:
+    """The slot of ``key`` in the open-addressing table ``keys`` (a power-of-two size, -1 for
+    empty, never full): where it is, or the empty slot where it goes (linear probing)."""
+    mask = keys.shape[0] - 1
+    hv = np.uint64(key) * np.uint64(0x9E3779B97F4A7C15)
+    i = np.int64(hv ^ (hv >> np.uint64(32))) & mask
+    while keys[i] != -1 and keys[i] != key:
+        i = (i + 1) & mask
+    return i
+
+
+@njit(cache=True)
+def _grown(keys: np.ndarray, vals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The table (``keys``, ``vals``) in twice the slots."""
+    nk = np.full(2 * keys.shape[0], -1, dtype=np.int64)
+    nv = np.zeros(2 * keys.shape[0], dtype=np.int8)
+    for i in range(keys.shape[0]):
+        if keys[i] != -1:
+            j = _probe(nk, keys[i])
+            nk[j] = keys[i]
+            nv[j] = vals[i]
+    return nk, nv
+
+
 @njit(cache=True)
 def search(lm: LatticeMap, gt: np.ndarray, t_a: float, s_a: float, k_a: int, a: float, dt: float,
            kmax: int, m_goal: int, n_max: int, key_cells: int, t_cap: float, c_goal: int,
-           reach: int, v_max: float) -> np.ndarray:
+           reach: int, v_max: float, dense_cells: int = DENSE_CELLS) -> np.ndarray:
     """A* over lattice nodes (step n, m, k), cost = time, heuristic = the larger of the
     obstacle-free time to go and the relaxed bound of :func:`goal_times` (both admissible:
     its table ``gt``, computed with ``c_goal``, ``reach`` and ``v_max``, then
     :func:`free_goal_time` on the rows after it);
     returns the accelerations (-1, 0, 1) of the earliest motion from
     (m=0, k=k_a) at t_a to (m_goal, 0), or [-9] if none within n_max steps.
+
+    The marks of the nodes reached are kept in dense arrays up to ``dense_cells`` lattice
+    cells (:data:`DENSE_CELLS`), else in hash tables: the same answers.
 
     ``t_cap`` (inf: no cap) ends the search without a motion as soon as the least estimate f
     popped exceeds it; :func:`~anyplan.trajectory.spacetime.lattice.plan_velocity` passes the
@@ -222,12 +256,30 @@ def search(lm: LatticeMap, gt: np.ndarray, t_a: float, s_a: float, k_a: int, a: 
     vstep = a * dt
     nm = m_goal + 1
     s_goal = s_a + m_goal * delta
-    parent = np.zeros((n_max + 1, nm, kmax + 1), dtype=np.int8)
-    parent[0, 0, k_a] = 4
-    # One node per (step, map cell, speed): two lattice points in one cell at one speed and
-    # time differ by less than a cell; keeping the first (best f) bounds the search by the map.
+    kk = kmax + 1
+    # The nodes reached, (step n, m, k) -> the step's acceleration + 2 (4 at the start), and the
+    # (step, key cell, speed) taken (one node per (step, map cell, speed): two lattice points in
+    # one cell at one speed and time differ by less than a cell; keeping the first, best f,
+    # bounds the search by the map). Flat indices n (nm) kk + m kk + k < 2^27 (bounded_lattice).
+    # Dense arrays for a small lattice (the fastest); hash tables beyond ``dense_cells``, as a
+    # search reaches a narrow band of the lattice, whose dense arrays a long path made hundreds
+    # of MB to allocate and zero on every search.
     ncell = forbidden.shape[1]
-    seen = np.zeros((n_max + 1, ncell, kmax + 1), dtype=np.bool_)
+    dense = (n_max + 1) * max(nm, ncell) * kk <= dense_cells
+    pd = np.zeros((n_max + 1) * nm * kk if dense else 1, dtype=np.int8)
+    sd = np.zeros((n_max + 1) * ncell * kk if dense else 1, dtype=np.bool_)
+    size0 = 1 if dense else 1024
+    pk = np.full(size0, -1, dtype=np.int64)
+    pv = np.zeros(size0, dtype=np.int8)
+    sk = np.full(size0, -1, dtype=np.int64)
+    sv = np.zeros(size0, dtype=np.int8)
+    if dense:
+        pd[k_a] = 4
+    else:
+        pk[_probe(pk, k_a)] = k_a
+        pv[_probe(pk, k_a)] = 4
+    n_parent = 1
+    n_seen = 0
     heap = [(to_go(s_goal - s_a, k_a * vstep, a, kmax * vstep), 0, 0, 0, k_a)]
     found = -1
     while len(heap) > 0:
@@ -247,11 +299,25 @@ def search(lm: LatticeMap, gt: np.ndarray, t_a: float, s_a: float, k_a: int, a: 
             if k2 < 0 or k2 > kmax:
                 continue
             m2 = m + 2 * k + u
-            if m2 > m_goal or parent[n + 1, m2, k2] != 0:
+            if m2 > m_goal:
                 continue
-            key = min(int((s_a + m2 * delta) / (max(key_cells, 1) * ds)), ncell - 1)
-            if key_cells > 0 and seen[n + 1, key, k2] and m2 != m_goal:
+            node = ((n + 1) * nm + m2) * kk + k2
+            pslot = 0 if dense else _probe(pk, node)  # (no table changes until the node is added)
+            if (pd[node] != 0) if dense else (pk[pslot] == node):
                 continue
+            cell = -1
+            sslot = 0
+            taken = False
+            if key_cells > 0:
+                key = min(int((s_a + m2 * delta) / (key_cells * ds)), ncell - 1)
+                cell = ((n + 1) * ncell + key) * kk + k2
+                if dense:
+                    taken = sd[cell]
+                else:
+                    sslot = _probe(sk, cell)
+                    taken = sk[sslot] == cell
+                if taken and m2 != m_goal:
+                    continue
             if not edge_ok(forbidden, t_map, h, ds, xcap0, xcap1, t, s, v, u * a, dt, nrow):
                 continue
             s2 = s_a + m2 * delta
@@ -262,8 +328,21 @@ def search(lm: LatticeMap, gt: np.ndarray, t_a: float, s_a: float, k_a: int, a: 
                   free_goal_time(j2, c2, t_map, h, c_goal, reach, ds, v_max, nrow))
             if g2 == np.inf:
                 continue  # the goal cannot be reached from there within the map
-            parent[n + 1, m2, k2] = u + 2
-            seen[n + 1, key, k2] = True
+            if dense:
+                pd[node] = u + 2
+                if key_cells > 0:
+                    sd[cell] = True
+            else:
+                pk[pslot] = node
+                pv[pslot] = u + 2
+                n_parent += 1
+                if 2 * n_parent > pk.shape[0]:
+                    pk, pv = _grown(pk, pv)
+                if key_cells > 0 and not taken:
+                    sk[sslot] = cell
+                    n_seen += 1
+                    if 2 * n_seen > sk.shape[0]:
+                        sk, sv = _grown(sk, sv)
             f = t2 + max(to_go(s_goal - s2, k2 * vstep, a, kmax * vstep), g2 - t2)
             heapq.heappush(heap, (f, -m2, n + 1, m2, k2))
     if found < 0:
@@ -271,7 +350,8 @@ def search(lm: LatticeMap, gt: np.ndarray, t_a: float, s_a: float, k_a: int, a: 
     acts = np.empty(found, dtype=np.int64)
     m, k = m_goal, 0
     for n in range(found, 0, -1):
-        u = int(parent[n, m, k]) - 2
+        node = (n * nm + m) * kk + k
+        u = int(pd[node] if dense else pv[_probe(pk, node)]) - 2
         acts[n - 1] = u
         k_prev = k - u
         m = m - 2 * k_prev - u

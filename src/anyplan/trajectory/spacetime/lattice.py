@@ -19,7 +19,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from anyplan.trajectory.spacetime._lattice_kernels import LatticeMap, edge_ok, goal_times, search
+from anyplan.trajectory.spacetime._lattice_kernels import (
+    DENSE_CELLS,
+    LatticeMap,
+    edge_ok,
+    goal_times,
+    search,
+)
 
 __all__ = ["VelocityPlan", "plan_velocity", "lattice_dt", "bounded_lattice", "lattice_cells",
            "edge_ok", "goal_times", "MAX_LATTICE_CELLS"]
@@ -110,7 +116,7 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
                   xcap1: np.ndarray, length: float, t0: float, v0: float, a_max: float,
                   v_max: float, *, target_dt: float = 0.25, horizon_s: float = 60.0,
                   key_cells: int = 4, cap: bool = True, frontier: bool = True,
-                  rows: int | None = None) -> VelocityPlan | None:
+                  rows: int | None = None, dense_cells: int | None = None) -> VelocityPlan | None:
     """The earliest lattice motion from (t0, s=0, v0) to rest at (about) the path's end.
 
     Args:
@@ -140,6 +146,9 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
         rows: The map's rows, of which ``forbidden`` holds the first (the rows after them are
             free: :class:`~anyplan.trajectory.spacetime.STMap` keeps only the rows its
             predictions reach); None: ``forbidden`` holds them all.
+        dense_cells: The lattice size above which the search keeps its marks in hash tables
+            rather than dense arrays (the same answer; None: ``DENSE_CELLS`` of the kernels,
+            2^22; tests pass 0 for the tables always).
 
     Returns:
         The :class:`VelocityPlan`, or None if no lattice motion reaches the end in the horizon.
@@ -188,7 +197,8 @@ def plan_velocity(forbidden: np.ndarray, t_map: float, h: float, ds: float, xcap
         acts = search(lm, gt, float(t_a), float(s_a), int(k_a), float(a_max), float(dt),
                       int(kmax), int(m_goal), n_max, int(key_cells),
                       float(t_a) + n_max * float(dt) + 1e-6 if cap else math.inf,
-                      max(c_goal, 0), reach, float(v_max))
+                      max(c_goal, 0), reach, float(v_max),
+                      DENSE_CELLS if dense_cells is None else int(dense_cells))
         if len(acts) == 1 and acts[0] == -9:
             continue
         ks = np.concatenate([[k_a], k_a + np.cumsum(acts)])
