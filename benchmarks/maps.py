@@ -29,6 +29,9 @@ Sections (every time is wall-clock on a shared machine; compare within one run):
    ``paper-3`` scenario runs first as the peer.
 3. **Many moving obstacles.** The same for 25, 50 and 100 pacing obstacles in a 40 m x 30 m hall
    (:mod:`anyplan.experiments.many`).
+4. **Long routes.** ``st-bitstar`` along corridors 30, 150 and 600 m long with pillars and a
+   walker every 40 m, tracked (``anyplan.experiments.many.long_route``): the same figures, and
+   the largest call; a call's cost should not grow with the route's length.
 
 Targets (issue 11): office 30 x 20 m: BIT* first solution <= 10 ms, <= 1.02 x the optimum at
 200 ms, a valid path every time; seq-bitstar across it with walkers without collision,
@@ -235,14 +238,16 @@ def _drive(sc: Scenario, planners: list[str], runs: int, label: str,
                "perception": perception or "scenario",
                "first_plan_ms_median": statistics.median(1e3 * t for t in first) if first else None,
                "replan_ms_median": statistics.median(ms),
-               "replan_ms_p90": ms[min(len(ms) - 1, int(0.9 * len(ms)))], "replans": len(times),
+               "replan_ms_p90": ms[min(len(ms) - 1, int(0.9 * len(ms)))], "replan_ms_max": ms[-1],
+               "replans": len(times),
                "replan_own_ms_median": statistics.median(1e3 * t for t in own) if own else None,
                "replans_own": len(own),
                "time_to_goal_s": statistics.median(ttg) if ttg else None, "rss_mb": _rss_mb(),
                "run_cpu_s": cpu, "run_wall_s": wall, "trajectory_digest": digest.hexdigest()[:10]}
         rows.append(row)
         replan = (f"replanning median {row['replan_ms_median']:.1f} ms, p90 "
-                  f"{row['replan_ms_p90']:.1f} ms over {len(times)} calls" if times else
+                  f"{row['replan_ms_p90']:.1f} ms, max {ms[-1]:.1f} ms over {len(times)} calls"
+                  if times else
                   "no replanning")
         if len(own) != len(times):
             om = row["replan_own_ms_median"]
@@ -280,13 +285,26 @@ def dynamic_section(maps_dir: Path, quick: bool, configs: dict[str, dict[str, An
     return rows
 
 
+def long_section(configs: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
+    """Section 4: st-bitstar along corridors 30, 150 and 600 m long (walkers tracked)."""
+    from anyplan.experiments.many import long_route
+
+    print("\nlong routes: a corridor 12 m wide with pillars and a walker every 40 m, walkers "
+          "tracked (8 m range); st-bitstar (a call's cost should not grow with the route; peak "
+          "RSS is the process's so far)")
+    rows = []
+    for length in (30.0, 150.0, 600.0):
+        rows += _drive(long_route(length, rng=1), ["st-bitstar"], 1, f"corridor {length:g} m", configs)
+    return rows
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="the 30 x 20 office only, 5 seeds")
     ap.add_argument("--seeds", type=int, default=None, help="BIT* seeds per map (10; quick 5)")
     ap.add_argument("--out", default=None, help="keep the generated maps in this directory")
     ap.add_argument("--json", default=None, help="write every figure to this file")
-    ap.add_argument("--no-dynamic", action="store_true", help="skip sections 2 and 3")
+    ap.add_argument("--no-dynamic", action="store_true", help="skip sections 2, 3 and 4")
     ap.add_argument("--no-static", action="store_true", help="skip section 1")
     ap.add_argument("--perception", choices=("oracle", "twist", "tracked"), default=None,
                     help="how the robot perceives the office's walkers (default: the scenario's "
@@ -311,6 +329,7 @@ def main(argv: list[str] | None = None) -> int:
             out["static"] = static_section(maps_dir, args.quick, seeds)
         if not args.no_dynamic:
             out["dynamic"] = dynamic_section(maps_dir, args.quick, configs, args.perception)
+            out["long"] = long_section(configs)
     if args.json:
         Path(args.json).write_text(json.dumps(out, indent=1, default=float))
     return 0

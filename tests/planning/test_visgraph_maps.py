@@ -115,3 +115,28 @@ def test_flood_fill_agrees_with_connected_component_labelling(seed):
         b = (int(rng.integers(ny)), int(rng.integers(nx)))
         want = bool(labels[a] != 0 and labels[a] == labels[b])
         assert connected8(grid, *a, *b) == want
+
+
+def test_long_routes_are_seeded_valid_and_driven():
+    # The long-route corridors of benchmarks/maps.py: seeded, walkers inside the corridor, a
+    # tracked sensor, pillars off the route's axis; a length below 10 m refused; and the 30 m
+    # one driven to its goal without a collision.
+    from anyplan.agents import make_agent
+    from anyplan.experiments.many import long_route
+    from anyplan.simulation import simulate
+
+    a, b = long_route(150.0, rng=2), long_route(150.0, rng=2)
+    assert a.content_hash() == b.content_hash() != long_route(150.0, rng=3).content_hash()
+    assert len(a.moving_obstacles) == 4 and len(a.static_obstacles) == 12
+    assert a.sensing.mode == "tracked" and a.robot.sensing_range == 8.0
+    x0, y0, x1, y1 = a.bounds
+    for o in a.moving_obstacles:
+        for t in np.linspace(0.0, 200.0, 101):
+            p = o.position(float(t))
+            assert x0 <= p[0] <= x1 and y0 <= p[1] <= y1
+    axis = np.array([a.robot.start[:2], a.robot.goal[:2]])  # the pillars leave the axis free
+    assert ObstacleSet([s.shape for s in a.static_obstacles]).segment_free(*axis, a.robot.radius)
+    with pytest.raises(ValueError, match="length must be >= 10 m"):
+        long_route(5.0)
+    res = simulate(long_route(30.0, rng=1), make_agent("st-bitstar"), seed=0)
+    assert res.reached_goal and not res.collision

@@ -1,4 +1,4 @@
-"""Scenarios with many moving obstacles (25, 50, 100, ...) in an open hall.
+"""Scenarios with many moving obstacles (25, 50, 100, ...) in an open hall, and long routes.
 
 The robot (:data:`anyplan.experiments.floorplans.ROBOT`, a 0.3 m disc at 1 m/s) crosses a
 ``width`` x ``height`` hall from (2, 2) to (width - 2, height - 2). Each obstacle is a disc
@@ -6,7 +6,8 @@ The robot (:data:`anyplan.experiments.floorplans.ROBOT`, a 0.3 m disc at 1 m/s) 
 hall (a looping ``waypoints`` motion), starting at least 2 m from the robot's start and goal;
 a third of them pace across the robot's straight route (their two points on either side of
 it), so that the route is crowded rather than merely surrounded. Everything is drawn from one
-``numpy.random.Generator``: a seed gives the same scenario.
+``numpy.random.Generator``: a seed gives the same scenario. :func:`long_route` is a corridor
+hundreds of metres long with pillars and walkers along it (the cost of planning far ahead).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ import numpy as np
 from anyplan.experiments.floorplans import ROBOT
 from anyplan.world.scenario import Scenario, scenario_from_dict
 
-__all__ = ["many_obstacles"]
+__all__ = ["long_route", "many_obstacles"]
 
 
 def many_obstacles(n: int, rng: np.random.Generator | int = 0, *, width: float = 40.0,
@@ -72,3 +73,42 @@ def many_obstacles(n: int, rng: np.random.Generator | int = 0, *, width: float =
         "dynamic_obstacles": obstacles,
     }
     return scenario_from_dict(data, f"<many-{n}>")
+
+
+def long_route(length: float, rng: np.random.Generator | int = 0, *, width: float = 12.0,
+               walker_every: float = 40.0) -> Scenario:
+    """A ``length`` x ``width`` [m] corridor driven end to end (start and goal 2 m from its ends,
+    on its axis): square pillars (1 m) every 12 m, alternately 2 m above and below the axis,
+    and one walker (a 0.25 m disc) per ``walker_every`` metres pacing 20 m along the corridor
+    at 0.8-1.2 m/s in a lane drawn across it, seen as the robot's sensor sees them
+    (``sensing: tracked``, 8 m of range; the first walker paces towards the start).
+    """
+    if not length >= 10.0:
+        raise ValueError(f"length must be >= 10 m, got {length}")
+    g = np.random.default_rng(rng)
+    mid = 0.5 * width
+    pillars = [{"name": f"S{i}", "type": "rectangle", "center": [float(x), mid + (2.0 if i % 2 else -2.0)],
+                "size": [1.0, 1.0], "angle": 0.0}
+               for i, x in enumerate(np.arange(10.0, length - 5.0, 12.0))]
+    walkers: list[dict[str, Any]] = []
+    for k, x0 in enumerate(np.arange(8.0, length - 8.0, walker_every)):
+        y = float(g.uniform(1.0, width - 1.0))
+        a, b = float(x0) + 20.0, float(x0)  # from the far end towards the start first
+        b = max(b, 3.0)
+        v = float(g.uniform(0.8, 1.2))
+        t1 = (a - b) / v
+        walkers.append({"name": f"W{k}", "type": "waypoints", "radius": 0.25,
+                        "keyframes": [[0.0, a, y], [round(t1, 6), b, y], [round(2 * t1, 6), a, y]]})
+    route = length - 4.0
+    data = {
+        "name": f"long-route-{length:g}",
+        "description": f"{length:g} m x {width:g} m corridor, pillars, {len(walkers)} walkers",
+        "time_limit": 1.5 * route / ROBOT["v_max"] + 60.0,
+        "arena": {"width": float(length), "height": float(width)},
+        "robot": {"start": [2.0, mid, 0.0], "goal": [length - 2.0, mid], **ROBOT,
+                  "sensing_range": 8.0},
+        "static_obstacles": pillars,
+        "dynamic_obstacles": walkers,
+        "sensing": {"mode": "tracked"},
+    }
+    return scenario_from_dict(data, f"<long-route-{length:g}>")
