@@ -15,6 +15,14 @@ DS, H = 0.05, 0.05
 A, V = 0.4, 0.4
 
 
+def _assert_same_plan(a, b) -> None:
+    """Both plans None, or equal bit for bit (times, arc lengths, speeds, accelerations)."""
+    assert (a is None) == (b is None)
+    if a is not None and b is not None:
+        for f in ("t", "s", "v", "a"):
+            assert np.array_equal(getattr(a, f), getattr(b, f))
+
+
 def _caps(length: float, cap: float = V * V) -> tuple[np.ndarray, np.ndarray]:
     n = int(math.ceil(length / DS))
     return np.full(n, cap), np.full(n, cap)
@@ -169,10 +177,7 @@ def test_capped_search_gives_the_exhaustive_answer(seed):
     for key in (0, 4):
         a, b = (plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, v0, A, V,
                               horizon_s=horizon, key_cells=key, cap=cap) for cap in (True, False))
-        assert (a is None) == (b is None)
-        if a is not None and b is not None:
-            for f in ("t", "s", "v", "a"):
-                assert np.array_equal(getattr(a, f), getattr(b, f))
+        _assert_same_plan(a, b)
 
 
 @pytest.mark.parametrize("seed", range(12))
@@ -195,10 +200,7 @@ def test_goal_bounds_on_the_reachable_cells_only_give_the_same_answer(seed):
         a, b = (plan_velocity(forbidden, t_map, H, DS, x0, x1, length, 0.0, v0, am, vm,
                               horizon_s=forbidden.shape[0] * H + t_map, key_cells=key,
                               frontier=f) for f in (True, False))
-        assert (a is None) == (b is None)
-        if a is not None and b is not None:
-            for f in ("t", "s", "v", "a"):
-                assert np.array_equal(getattr(a, f), getattr(b, f))
+        _assert_same_plan(a, b)
 
 
 def _goal_times_by_definition(forbidden, t_map, h, c_goal, reach, ds, v_max, c_first):
@@ -290,10 +292,7 @@ def test_a_map_without_its_free_rows_gives_the_same_bounds_and_plans_bit_for_bit
                           horizon_s=nrow * H)
         b = plan_velocity(forbidden[:r_dense], 0.0, H, DS, x0, x1, length, 0.0, v0, A, V,
                           key_cells=key, horizon_s=nrow * H, rows=nrow)
-        assert (a is None) == (b is None)
-        if a is not None and b is not None:
-            for f in ("t", "s", "v", "a"):
-                assert np.array_equal(getattr(a, f), getattr(b, f))
+        _assert_same_plan(a, b)
 
 
 @pytest.mark.parametrize("seed", range(12))
@@ -312,10 +311,7 @@ def test_the_search_kept_in_hash_tables_finds_the_same_plans(seed):
     for key in (0, 4):
         a, b = (plan_velocity(forbidden, 0.0, H, DS, x0, x1, length, 0.0, v0, A, V, key_cells=key,
                               horizon_s=forbidden.shape[0] * H, dense_cells=d) for d in (None, 0))
-        assert (a is None) == (b is None)
-        if a is not None and b is not None:
-            for f in ("t", "s", "v", "a"):
-                assert np.array_equal(getattr(a, f), getattr(b, f))
+        _assert_same_plan(a, b)
 
 
 def test_a_map_cannot_claim_fewer_rows_than_it_holds():
