@@ -64,8 +64,8 @@ _DIVERGING_ROUNDS = 3
 #: Longest polyline segment [m] the spline is fitted over: longer ones are split evenly first.
 #: A C2 spline through points hundreds of metres apart swings metres off its polyline after a
 #: turn (14 m out of a 12 m corridor on a 600 m path), and the repair then certifies the whole
-#: curve round after round. Above the arenas of the benchmarks (the longest segment smoothed on
-#: DynaBARN's 23 m x 21 m worlds is 20.3 m), so their curves are unchanged.
+#: curve round after round. Above the segments of the benchmarks' arenas (the longest smoothed
+#: on DynaBARN's 23 m x 21 m worlds is 20.3 m), but for the 40 m x 30 m hall of many obstacles.
 MAX_SEGMENT_M = 25.0
 
 
