@@ -374,10 +374,12 @@ def certify_worst(cv: CurveArrays, limit: float, radius: float, max_depth: int,
             # >= max(clr(P), 0) - dev(P) / 16^levels
             if has[kj] and max(cj, 0.0) - sv[top] / 16.0 ** (max_depth - depth) - slack >= best_c[kj]:
                 continue
-            # a buried piece's leaves are all -dev (no distance is computed, so no slack of the
-            # coordinates' size): the bound above, made for distances, keeps every such piece
-            # of a curve far outside the arena (4^depth leaves each); this one does not
-            if buried and has[kj] and -leaf_dev_bound(x, c, a, b, max_depth - depth) > best_c[kj]:
+            # every leaf's chord clearance is >= 0, so its value is >= -(its dev): a bound with
+            # no computed distance in it, so no slack of the coordinates' size. The bound above
+            # cannot prune pieces inside an obstacle or beyond a wall (each leaf -dev, about
+            # -1e-10 m, below that slack): 4^depth leaves each, on a curve far out of its arena
+            # or through a map's walls; this one prunes them once a leaf below them is found
+            if has[kj] and best_c[kj] < 0.0 and -leaf_dev_bound(x, c, a, b, max_depth - depth) > best_c[kj]:
                 continue
             w = b - a
             n_c = 0
