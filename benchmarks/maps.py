@@ -30,8 +30,9 @@ Sections (every time is wall-clock on a shared machine; compare within one run):
 3. **Many moving obstacles.** The same for 25, 50 and 100 pacing obstacles in a 40 m x 30 m hall
    (:mod:`anyplan.experiments.many`).
 4. **Long routes.** ``st-bitstar`` along corridors 30, 150 and 600 m long with pillars and a
-   walker every 40 m, tracked (``anyplan.experiments.many.long_route``): the same figures, and
-   the largest call; a call's cost should not grow with the route's length.
+   walker every 40 m (``anyplan.experiments.many.long_route``) and across a 100 m x 60 m
+   warehouse map with 6 walkers, walkers tracked: the same figures, and the largest call; a
+   call's cost should not grow with the route's length.
 
 Targets (issue 11): office 30 x 20 m: BIT* first solution <= 10 ms, <= 1.02 x the optimum at
 200 ms, a valid path every time; seq-bitstar across it with walkers without collision,
@@ -285,16 +286,22 @@ def dynamic_section(maps_dir: Path, quick: bool, configs: dict[str, dict[str, An
     return rows
 
 
-def long_section(configs: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
-    """Section 4: st-bitstar along corridors 30, 150 and 600 m long (walkers tracked)."""
+def long_section(maps_dir: Path, configs: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
+    """Section 4: st-bitstar along corridors 30, 150 and 600 m long and across a 100 m x 60 m
+    warehouse map (walkers tracked)."""
+    from anyplan.experiments.floorplans import map_scenario, roughen, warehouse
     from anyplan.experiments.many import long_route
 
-    print("\nlong routes: a corridor 12 m wide with pillars and a walker every 40 m, walkers "
-          "tracked (8 m range); st-bitstar (a call's cost should not grow with the route; peak "
-          "RSS is the process's so far)")
+    print("\nlong routes: a corridor 12 m wide with pillars and a walker every 40 m, and a "
+          "100 m x 60 m warehouse map with 6 walkers, walkers tracked (8 m range); st-bitstar "
+          "(a call's cost should not grow with the route; peak RSS is the process's so far)")
     rows = []
     for length in (30.0, 150.0, 600.0):
         rows += _drive(long_route(length, rng=1), ["st-bitstar"], 1, f"corridor {length:g} m", configs)
+    plan = roughen(warehouse(100.0, 60.0, rng=1), 0.3, 50, rng=1)
+    path = map_scenario(plan, maps_dir, "warehouse-walkers-6", n_walkers=6, rng=6, time_limit=480.0)
+    rows += _drive(load_scenario(path), ["st-bitstar"], 1, "warehouse 100x60 + 6 walkers", configs,
+                   "tracked")
     return rows
 
 
@@ -329,7 +336,7 @@ def main(argv: list[str] | None = None) -> int:
             out["static"] = static_section(maps_dir, args.quick, seeds)
         if not args.no_dynamic:
             out["dynamic"] = dynamic_section(maps_dir, args.quick, configs, args.perception)
-            out["long"] = long_section(configs)
+            out["long"] = long_section(maps_dir, configs)
     if args.json:
         Path(args.json).write_text(json.dumps(out, indent=1, default=float))
     return 0
