@@ -168,7 +168,8 @@ def test_a_long_path_is_fitted_over_segments_of_at_most_max_segment():
     # 15 m out of the 12 m corridor, and the repair certified all 600 m round after round.
     # Over segments of at most MAX_SEGMENT_M the first fit stays in the corridor and is
     # certified at once; the points added lie on the polyline (the route is unchanged).
-    from anyplan.trajectory.spline.smooth import MAX_SEGMENT_M, split_long_segments
+    from anyplan.trajectory.path import split_long_segments
+    from anyplan.trajectory.spline.smooth import MAX_SEGMENT_M
 
     path = np.array([[0.0, 0.0], [3.3, 1.5], [95.0, 0.0], [132.7, 1.0], [596.0, 0.0]])
     dense = split_long_segments(path, MAX_SEGMENT_M)

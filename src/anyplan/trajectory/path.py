@@ -1,5 +1,6 @@
 """Cleaning a planned polyline before it is smoothed: repeated, collinear and skippable vertices;
-the rest of a path from a point on the way (:func:`remaining_path`).
+long segments split (:func:`split_long_segments`); the rest of a path from a point on the way
+(:func:`remaining_path`).
 
 Sampling planners return many jittery vertices (BIT* at a fixed budget: one every few
 centimetres, off the straight line by millimetres), and a spline through all of them wiggles.
@@ -12,12 +13,14 @@ certification").
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
 from anyplan.trajectory import _path
 
-__all__ = ["clean_path", "polyline_length", "remaining_path", "shortcut_path"]
+__all__ = ["clean_path", "polyline_length", "remaining_path", "shortcut_path", "split_long_segments"]
 
 
 def clean_path(path: np.ndarray, tol: float = 1e-9, collinear_tol: float = 1e-9) -> np.ndarray:
@@ -90,3 +93,22 @@ def remaining_path(path: np.ndarray, p: np.ndarray) -> np.ndarray:
     if len(rest) and float(np.hypot(*(rest[0] - p))) < 1e-6:
         rest = rest[1:]
     return np.vstack([p, rest]) if len(rest) else np.vstack([p, path[-1:]])
+
+
+def split_long_segments(pts: np.ndarray, max_len: float) -> np.ndarray:
+    """``pts`` (N, 2) [m] with every segment longer than ``max_len`` [m] split into equal parts
+    of at most ``max_len`` (points on the segment: the route is unchanged).
+
+    Examples:
+        >>> split_long_segments(np.array([[0.0, 0.0], [60.0, 0.0], [60.0, 10.0]]), 25.0)[:, 0]
+        array([ 0., 20., 40., 60., 60.])
+    """
+    d = np.hypot(*np.diff(pts, axis=0).T)
+    if not (d > max_len).any():
+        return pts
+    out = [pts[:1]]
+    for j, dj in enumerate(d.tolist()):
+        n = int(math.ceil(dj / max_len)) if dj > max_len else 1
+        f = np.arange(1, n + 1)[:, None] / n
+        out.append(pts[j] + f * (pts[j + 1] - pts[j]))
+    return np.concatenate(out)

@@ -21,11 +21,11 @@ import numpy as np
 
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.se2 import dot2
-from anyplan.trajectory.path import clean_path
+from anyplan.trajectory.path import clean_path, split_long_segments
 from anyplan.trajectory.spline.clearance import worst_failures, worst_per_group
 from anyplan.trajectory.spline.curve import SmoothCurve
 
-__all__ = ["MAX_SEGMENT_M", "SmoothingResult", "smooth_path", "split_long_segments"]
+__all__ = ["MAX_SEGMENT_M", "SmoothingResult", "smooth_path"]
 
 
 @dataclass
@@ -61,31 +61,13 @@ _MEMO_SIZE = 16
 #: 1, 2, 4, 8, ... intervals and ran all 10 rounds, 2.6 s of the 4.3 s spent smoothing.
 _DIVERGING_ROUNDS = 3
 
-#: Longest polyline segment [m] the spline is fitted over: longer ones are split evenly first.
+#: Longest polyline segment [m] the spline is fitted over: longer ones are split evenly first
+#: (:func:`~anyplan.trajectory.path.split_long_segments`).
 #: A C2 spline through points hundreds of metres apart swings metres off its polyline after a
 #: turn (14 m out of a 12 m corridor on a 600 m path), and the repair then certifies the whole
 #: curve round after round. Above the segments of the benchmarks' arenas (the longest smoothed
 #: on DynaBARN's 23 m x 21 m worlds is 20.3 m), but for the 40 m x 30 m hall of many obstacles.
 MAX_SEGMENT_M = 25.0
-
-
-def split_long_segments(pts: np.ndarray, max_len: float) -> np.ndarray:
-    """``pts`` (N, 2) [m] with every segment longer than ``max_len`` [m] split into equal parts
-    of at most ``max_len`` (points on the segment: the route is unchanged).
-
-    Examples:
-        >>> split_long_segments(np.array([[0.0, 0.0], [60.0, 0.0], [60.0, 10.0]]), 25.0)[:, 0]
-        array([ 0., 20., 40., 60., 60.])
-    """
-    d = np.hypot(*np.diff(pts, axis=0).T)
-    if not (d > max_len).any():
-        return pts
-    out = [pts[:1]]
-    for j, dj in enumerate(d.tolist()):
-        n = int(math.ceil(dj / max_len)) if dj > max_len else 1
-        f = np.arange(1, n + 1)[:, None] / n
-        out.append(pts[j] + f * (pts[j + 1] - pts[j]))
-    return np.concatenate(out)
 
 
 def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
