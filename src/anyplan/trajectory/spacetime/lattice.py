@@ -30,11 +30,13 @@ from anyplan.trajectory.spacetime._lattice_kernels import (
 __all__ = ["VelocityPlan", "plan_velocity", "lattice_dt", "bounded_lattice", "lattice_cells",
            "edge_ok", "goal_times", "MAX_LATTICE_CELLS"]
 
-#: Largest velocity lattice searched, in cells of the search's dense arrays (one byte each, see
-#: :func:`lattice_cells`). The robots of the built-in, generated and benchmark scenarios need
-#: below 10^7 (the paper's robot on a 30 m path: 6 x 10^6); a robot at the schema's limits
-#: (a_max 0.001 or 1000 m/s^2) or a path of hundreds of metres asked for 10^9 to 10^11 and
-#: failed with MemoryError (:func:`bounded_lattice`).
+#: Largest velocity lattice searched, in cells (:func:`lattice_cells`). The robots of the
+#: built-in, generated and benchmark scenarios need below 10^7 (the paper's robot on a 30 m
+#: path: 6 x 10^6); a robot at the schema's limits (a_max 0.001 or 1000 m/s^2) or a path of
+#: hundreds of metres asked for 10^9 to 10^11 and failed with MemoryError when the search kept
+#: its marks in dense arrays of this size (:func:`bounded_lattice`). Above ``DENSE_CELLS`` it
+#: keeps them in hash tables, whose size follows the nodes reached; the bound still caps what
+#: a search that finds no motion can reach.
 MAX_LATTICE_CELLS = 2 ** 27
 
 
@@ -84,9 +86,9 @@ def lattice_dt(v_max: float, a_max: float, target_dt: float = 0.25) -> tuple[flo
 
 def lattice_cells(dt: float, kmax: int, a: float, horizon_s: float, length: float,
                   ncell: int) -> int:
-    """Cells of the search's dense arrays for a lattice of step ``dt`` [s], ``kmax`` speed
-    levels and acceleration ``a`` [m/s^2] over ``horizon_s`` [s] on a path of ``length`` [m]
-    and ``ncell`` map columns: (steps + 1) x (kmax + 1) x (positions + map columns)."""
+    """Cells of a lattice of step ``dt`` [s], ``kmax`` speed levels and acceleration ``a``
+    [m/s^2] over ``horizon_s`` [s] on a path of ``length`` [m] and ``ncell`` map columns:
+    (steps + 1) x (kmax + 1) x (positions + map columns), the search's nodes and key cells."""
     n = int(math.ceil(horizon_s / dt)) + 1
     m = int(math.floor(length / (0.5 * a * dt * dt))) + 2
     return n * (kmax + 1) * (m + ncell)
@@ -95,7 +97,7 @@ def lattice_cells(dt: float, kmax: int, a: float, horizon_s: float, length: floa
 def bounded_lattice(v_max: float, a_max: float, target_dt: float, horizon_s: float, length: float,
                     ncell: int) -> tuple[float, int, float]:
     """Step ``dt`` [s], speed levels K and acceleration ``a`` <= ``a_max`` [m/s^2] of the
-    lattice (v_max = K a dt): :func:`lattice_dt`'s, unless its arrays would exceed
+    lattice (v_max = K a dt): :func:`lattice_dt`'s, unless its cells would exceed
     :data:`MAX_LATTICE_CELLS`; then the step is doubled until they fit (fewer speed levels,
     and, once there are two, a smaller acceleration than the robot's: a motion of the coarser
     lattice is as feasible, it may only arrive later). A tiny ``a_max`` makes thousands of speed
