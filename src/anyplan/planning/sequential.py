@@ -101,7 +101,7 @@ class SequentialConfig:
     prediction_dt: float | None = setting(0.02, lo=0.0, lo_open=True, unit="s",
                                           doc="resampling step of the prediction; None: exact")
     max_time_s: float = setting(0.5, lo=0.0, lo_open=True, unit="s", doc="wall-clock cap of a replanning")
-    prove_blocked: bool = setting(False, doc="skip detour searches that provably cannot succeed")
+    prove_blocked: bool = setting(True, doc="skip detour searches that provably cannot succeed")
     bitstar: BITStarConfig = field(default_factory=BITStarConfig)
 
     def __post_init__(self) -> None:
