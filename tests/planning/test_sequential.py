@@ -321,3 +321,47 @@ def test_config_validation_names_the_field():
         SequentialConfig(anchor="centre")
     with pytest.raises(ValueError, match="planning_delay"):
         SequentialBITStarAgent(planning_delay="soon")
+
+
+def test_the_waiting_search_skips_later_departures_where_the_robot_is_struck_waiting():
+    """A corridor 1.3 m wide and a disc coming head-on down its centre line at 0.5 m/s: no
+    detour, and a robot waiting at the start is struck when the disc arrives (about 14.7 s).
+    A departure 16 s late is struck while it waits (before it leaves, ``departs_s``), so the
+    search tries no later one along that path; with ``departs_s`` hidden it tries them all,
+    and both searches give the same answer."""
+    from anyplan.trajectory.reference import ReferenceBuilder
+
+    spec = RobotSpec(start=(1.0, 0.65, 0.0), goal=(9.0, 0.65), radius=0.3, v_max=0.4,
+                     omega_max=0.4, a_max=0.4, alpha_max=1.0)
+    corridor = ObstacleSet([], bounds=(0.0, 0.0, 10.0, 1.3))
+    model = ReferenceBuilder(spec=spec, obstacles=corridor).departing(
+        RobotState(*spec.start, 0.0, 0.0), 0.0)
+    head_on = PredictedObstacle("H", 0.3, UnicycleMotion(9.0, 0.65, np.pi, 0.5))
+
+    def search(hide_departure):
+        delays = []
+
+        def motion_fn(path, shapes, delay):
+            delays.append(delay)
+            tr = model(path, shapes, delay)
+            if delay > 0.0:
+                assert tr.departs_s == tr.t_start + delay  # at rest: no braking first
+                if hide_departure:
+                    tr.departs_s = None
+            return tr
+
+        cfg = SequentialConfig(prediction_dt=0.02, batches_per_plan=2,
+                               wait_delays_s=(0.5, 1.0, 16.0, 20.0, 25.0))
+        loop = SequentialBITStar(corridor, robot_radius=0.3, plan_radius=0.33, motion=motion_fn,
+                                 config=cfg, rng=np.random.default_rng(0))
+        res = loop.replan(np.array(spec.start[:2]), np.array(spec.goal), [head_on], 0.0)
+        return res, [d for d in delays if d > 0.0]
+
+    skipped, tried = search(False)
+    full, tried_all = search(True)
+    assert tried_all == [0.5, 1.0, 16.0, 20.0, 25.0]
+    assert tried == [0.5, 1.0, 16.0]
+    assert skipped.status == full.status == "collision_predicted"
+    assert skipped.delay_s == full.delay_s
+    np.testing.assert_allclose(skipped.motion.positions(np.array([5.0])),
+                               full.motion.positions(np.array([5.0])))

@@ -43,6 +43,9 @@ class MotionModel(Protocol):
     ``model(path, extra_shapes, delay_s)`` is the timed reference motion along ``path`` (N, 2)
     [m] among the static obstacles plus ``extra_shapes`` (the virtual squares so far),
     departing ``delay_s`` [s] late. :class:`anyplan.trajectory.reference.Departure` is one.
+    A motion departing late may say when it leaves the point where it waits (``departs_s``
+    [s]; before that, a later departure along the same path is the same motion): the waiting
+    search then tries no later departure along a path whose contact comes while it waits.
     """
 
     def __call__(self, path: np.ndarray, extra_shapes: Sequence[Shape], delay_s: float,
@@ -419,13 +422,25 @@ class SequentialBITStar:
             return None
         # The first path (shortest, no squares) and the last (around every square so far).
         order = [0] if len(candidates) == 1 else [0, len(candidates) - 1]
-        for delay in self.config.wait_delays_s:
+        cfg = self.config
+        # A contact this long before the departure lies where every later departure along the
+        # same path stands still too (the same positions, samples and speed bound): one more
+        # step of the prediction's resampling on either side, and its time accuracy.
+        slack = 2.0 * (cfg.prediction_dt or 0.0) + 1e-3
+        struck: dict[int, float] = {}  # path -> the least delay struck while it waits
+        for delay in cfg.wait_delays_s:
             for i in order:
+                if delay >= struck.get(i, math.inf):
+                    continue  # it would wait longer where that departure is struck
                 if time.perf_counter() > deadline:
                     return None
                 path, shapes = candidates[i]
                 motion = motion_fn(path, shapes, delay)
-                if first_collision(motion, predictions, self.robot_radius, margin=self.config.margin,
-                                   sample_dt=self.config.prediction_dt) is None:
+                hit = first_collision(motion, predictions, self.robot_radius, margin=cfg.margin,
+                                      sample_dt=cfg.prediction_dt)
+                if hit is None:
                     return path, shapes, delay, motion
+                departs = getattr(motion, "departs_s", None)
+                if departs is not None and hit.t + slack <= departs:
+                    struck[i] = min(delay, struck.get(i, math.inf))
         return None

@@ -117,4 +117,5 @@ class Departure:
                            grid_step=b.grid_step)
         return Trajectory(segs + tail.segments, kind=WAIT_PREFIX + tail.kind, feasible=tail.feasible,
                           lower_bound_s=tail.lower_bound_s, polyline=tail.polyline,
-                          info=tail.info, certified_free=tail.certified_free)
+                          info=tail.info, certified_free=tail.certified_free,
+                          departs_s=t + delay_s)

@@ -111,12 +111,17 @@ class Trajectory:
             obstacles given to :func:`~anyplan.trajectory.plan_motion` (False only for a polyline
             fallback whose own segments, or braking path, are not free).
         info: Diagnostics (repair rounds, candidate times, ...).
+        departs_s: For a motion that brakes, stands still and then departs (a late departure,
+            :class:`~anyplan.trajectory.reference.Departure`): the time [s] it leaves the point
+            where it stood; before it the motion is the same for every later departure. None
+            otherwise.
     """
 
     def __init__(self, segments: Sequence[Segment], kind: str = MotionKind.SMOOTH,
                  feasible: bool = True,
                  lower_bound_s: float = float("nan"), polyline: np.ndarray | None = None,
-                 info: dict | None = None, certified_free: bool = True) -> None:
+                 info: dict | None = None, certified_free: bool = True,
+                 departs_s: float | None = None) -> None:
         if not segments:
             raise ValueError("a trajectory needs at least one segment")
         self.segments = list(segments)
@@ -126,6 +131,7 @@ class Trajectory:
         self.polyline = polyline
         self.certified_free = certified_free
         self.info = dict(info or {})
+        self.departs_s = departs_s
         self._starts = np.array([s.t0 for s in self.segments])
         self._starts_list: list[float] = self._starts.tolist()
         self._path: np.ndarray | None = None  # built on first use (see path)
