@@ -323,12 +323,10 @@ def test_config_validation_names_the_field():
         SequentialBITStarAgent(planning_delay="soon")
 
 
-def test_the_waiting_search_skips_later_departures_where_the_robot_is_struck_waiting():
-    """A corridor 1.3 m wide and a disc coming head-on down its centre line at 0.5 m/s: no
-    detour, and a robot waiting at the start is struck when the disc arrives (about 14.7 s).
-    A departure 16 s late is struck while it waits (before it leaves, ``departs_s``), so the
-    search tries no later one along that path; with ``departs_s`` hidden it tries them all,
-    and both searches give the same answer."""
+def _waiting_search(obstacles, hide_departure, delays=(0.5, 1.0, 16.0, 20.0, 25.0)):
+    """The loop in a corridor 1.3 m wide (no detour: a square closes it) with a model whose
+    late departures say when they leave (``departs_s``), or hide it; returns the result and the
+    delays the model was asked for."""
     from anyplan.trajectory.reference import ReferenceBuilder
 
     spec = RobotSpec(start=(1.0, 0.65, 0.0), goal=(9.0, 0.65), radius=0.3, v_max=0.4,
@@ -336,32 +334,62 @@ def test_the_waiting_search_skips_later_departures_where_the_robot_is_struck_wai
     corridor = ObstacleSet([], bounds=(0.0, 0.0, 10.0, 1.3))
     model = ReferenceBuilder(spec=spec, obstacles=corridor).departing(
         RobotState(*spec.start, 0.0, 0.0), 0.0)
+    asked = []
+
+    def motion_fn(path, shapes, delay):
+        tr = model(path, shapes, delay)
+        if delay > 0.0:
+            asked.append(delay)
+            assert tr.departs_s == tr.t_start + delay  # at rest: no braking first
+            if hide_departure:
+                tr.departs_s = None
+        return tr
+
+    cfg = SequentialConfig(prediction_dt=0.02, batches_per_plan=2, wait_delays_s=delays)
+    loop = SequentialBITStar(corridor, robot_radius=0.3, plan_radius=0.33, motion=motion_fn,
+                             config=cfg, rng=np.random.default_rng(0))
+    res = loop.replan(np.array(spec.start[:2]), np.array(spec.goal), obstacles, 0.0)
+    return res, asked
+
+
+def test_the_waiting_search_skips_later_departures_where_the_robot_is_struck_waiting():
+    """A corridor 1.3 m wide and a disc coming head-on down its centre line at 0.5 m/s: no
+    detour, and a robot waiting at the start is struck when the disc arrives (about 14.7 s).
+    A departure 16 s late is struck while it waits (before it leaves, ``departs_s``), so the
+    search tries no later one along that path; with ``departs_s`` hidden it tries them all,
+    and both searches give the same answer."""
     head_on = PredictedObstacle("H", 0.3, UnicycleMotion(9.0, 0.65, np.pi, 0.5))
-
-    def search(hide_departure):
-        delays = []
-
-        def motion_fn(path, shapes, delay):
-            delays.append(delay)
-            tr = model(path, shapes, delay)
-            if delay > 0.0:
-                assert tr.departs_s == tr.t_start + delay  # at rest: no braking first
-                if hide_departure:
-                    tr.departs_s = None
-            return tr
-
-        cfg = SequentialConfig(prediction_dt=0.02, batches_per_plan=2,
-                               wait_delays_s=(0.5, 1.0, 16.0, 20.0, 25.0))
-        loop = SequentialBITStar(corridor, robot_radius=0.3, plan_radius=0.33, motion=motion_fn,
-                                 config=cfg, rng=np.random.default_rng(0))
-        res = loop.replan(np.array(spec.start[:2]), np.array(spec.goal), [head_on], 0.0)
-        return res, [d for d in delays if d > 0.0]
-
-    skipped, tried = search(False)
-    full, tried_all = search(True)
+    skipped, tried = _waiting_search([head_on], False)
+    full, tried_all = _waiting_search([head_on], True)
     assert tried_all == [0.5, 1.0, 16.0, 20.0, 25.0]
     assert tried == [0.5, 1.0, 16.0]
     assert skipped.status == full.status == "collision_predicted"
     assert skipped.delay_s == full.delay_s
     np.testing.assert_allclose(skipped.motion.positions(np.array([5.0])),
                                full.motion.positions(np.array([5.0])))
+
+
+def _crossing(x, t_centre, speed=0.5):
+    """A disc crossing the corridor upwards at ``x`` [m], on its centre line at ``t_centre`` [s]."""
+    return PredictedObstacle(f"X{x}", 0.3, UnicycleMotion(x, 0.65 - speed * t_centre, np.pi / 2,
+                                                          speed))
+
+
+@pytest.mark.parametrize("obstacles", [
+    [PredictedObstacle("H", 0.3, UnicycleMotion(9.0, 0.65, np.pi, 0.5))],  # head-on
+    [PredictedObstacle("H", 0.3, UnicycleMotion(9.0, 0.65, np.pi, 1.2))],  # head-on, fast
+    [_crossing(2.5, 4.8)],                      # blocks the way ahead for a while: wait 3 s
+    [_crossing(2.5, 4.8), _crossing(1.0, 2.5)],  # ... and crosses where the robot waits
+    [_crossing(2.5, 4.8), _crossing(1.0, 9.0)],  # ... there too, after the robot has left
+    [_crossing(2.5, 4.8), _crossing(4.0, 9.0, 0.3), _crossing(1.0, 14.0)],
+], ids=["head-on", "head-on-fast", "ahead", "ahead-and-here", "ahead-then-here", "three"])
+def test_the_waiting_search_decides_as_if_it_tried_every_delay(obstacles):
+    delays = (0.5, 1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 16.0, 20.0)
+    skipped, tried = _waiting_search(obstacles, False, delays)
+    full, tried_all = _waiting_search(obstacles, True, delays)
+    assert tried == tried_all[:len(tried)]  # the same order, fewer at most
+    assert (skipped.status, skipped.delay_s) == (full.status, full.delay_s)
+    np.testing.assert_array_equal(skipped.path, full.path)
+    assert (skipped.collision is None) == (full.collision is None)
+    if skipped.collision is not None:
+        assert skipped.collision.t == full.collision.t
