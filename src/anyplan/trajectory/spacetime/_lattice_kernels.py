@@ -212,14 +212,16 @@ def _probe(keys: np.ndarray, key: int) -> int:
 
 @njit(cache=True)
 def _grown(keys: np.ndarray, vals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The table (``keys``, ``vals``) in twice the slots."""
+    """The table (``keys``, ``vals``) in twice the slots; a table of keys alone (a set) has no
+    ``vals`` (empty) and keeps none."""
     nk = np.full(2 * keys.shape[0], -1, dtype=np.int64)
-    nv = np.zeros(2 * keys.shape[0], dtype=np.int8)
+    nv = np.zeros(2 * keys.shape[0] if vals.shape[0] > 0 else 0, dtype=np.int8)
     for i in range(keys.shape[0]):
         if keys[i] != -1:
             j = _probe(nk, keys[i])
             nk[j] = keys[i]
-            nv[j] = vals[i]
+            if nv.shape[0] > 0:
+                nv[j] = vals[i]
     return nk, nv
 
 
@@ -271,13 +273,14 @@ def search(lm: LatticeMap, gt: np.ndarray, t_a: float, s_a: float, k_a: int, a: 
     size0 = 1 if dense else 1024
     pk = np.full(size0, -1, dtype=np.int64)
     pv = np.zeros(size0, dtype=np.int8)
-    sk = np.full(size0, -1, dtype=np.int64)
-    sv = np.zeros(size0, dtype=np.int8)
+    sk = np.full(size0, -1, dtype=np.int64)  # a set: keys only
+    no_vals = np.zeros(0, dtype=np.int8)
     if dense:
         pd[k_a] = 4
     else:
-        pk[_probe(pk, k_a)] = k_a
-        pv[_probe(pk, k_a)] = 4
+        i0 = _probe(pk, k_a)
+        pk[i0] = k_a
+        pv[i0] = 4
     n_parent = 1
     n_seen = 0
     heap = [(to_go(s_goal - s_a, k_a * vstep, a, kmax * vstep), 0, 0, 0, k_a)]
@@ -342,7 +345,7 @@ def search(lm: LatticeMap, gt: np.ndarray, t_a: float, s_a: float, k_a: int, a: 
                     sk[sslot] = cell
                     n_seen += 1
                     if 2 * n_seen > sk.shape[0]:
-                        sk, sv = _grown(sk, sv)
+                        sk, _ = _grown(sk, no_vals)
             f = t2 + max(to_go(s_goal - s2, k2 * vstep, a, kmax * vstep), g2 - t2)
             heapq.heappush(heap, (f, -m2, n + 1, m2, k2))
     if found < 0:
