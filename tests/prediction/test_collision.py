@@ -285,9 +285,10 @@ def _start_bounds_per_length(obstacles, far, grid, gc, pc, vr, reach0):
 
 @pytest.mark.parametrize("seed", range(4))
 def test_start_bounds_of_tracks_of_every_length_at_once_are_the_per_length_ones(seed):
-    """Tracks of 2-9 keyframes interpolated in one padded stack: bit for bit the bounds of one
-    interpolation per keyframe count, with far, growing and other obstacles mixed in; the
-    padded stack cached for the same tracks is rebuilt for other ones."""
+    """Tracks of 2-9 keyframes in one padded stack, each scanned by the compiled kernel until
+    its first uncertified interval: bit for bit the bounds of one numpy interpolation per
+    keyframe count, with far, growing and other obstacles mixed in; the padded stack cached for
+    the same tracks is rebuilt for other ones."""
     from anyplan.prediction import collision
     from anyplan.prediction.base import RadiusGrowth
     from anyplan.world.motion import WaypointMotion

@@ -271,10 +271,11 @@ def _motion() -> None:
 
 def _contacts() -> None:
     """The closed-form first contacts of straight discs, growing or not, with a sampled motion
-    (the collision prediction's common case: twist and tracked predictions, straight movers)."""
+    (the collision prediction's common case: twist and tracked predictions, straight movers),
+    and the broad phase of looping tracks (pacing movers, DynaBARN's announced tracks)."""
     from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
-    from anyplan.prediction.collision import predict_collisions
-    from anyplan.world.motion import UnicycleMotion
+    from anyplan.prediction.collision import first_collision, predict_collisions
+    from anyplan.world.motion import UnicycleMotion, WaypointMotion
 
     class _Line:  # a robot reference on a straight line: x = t [m]
         t_start, t_end, max_speed = 0.0, 4.0, 1.0
@@ -288,6 +289,9 @@ def _contacts() -> None:
               PredictedObstacle("b", 0.2, UnicycleMotion(1.0, -2.0, 1.5708, 0.5))]
     predict_collisions(_Line(), movers, 0.2, sample_dt=0.02)
     predict_collisions(_Line(), movers[1:], 0.2, sample_dt=0.02)
+    pacing = PredictedObstacle("c", 0.2, WaypointMotion(np.array([[0.0, 2.0, 1.0], [2.0, 2.0, -1.0],
+                                                                  [4.0, 2.0, 1.0]])))
+    first_collision(_Line(), [pacing], 0.2, sample_dt=0.02)
 
 
 def _sequential() -> None:

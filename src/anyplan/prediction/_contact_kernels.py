@@ -8,7 +8,9 @@ position and the contact distance are both affine in time, so the squared gap
 ``|d(s)|^2 - c(s)^2`` is a quadratic and its first root is closed form: the first contact is
 exact up to rounding, with no time tolerance. :class:`StraightDiscs` holds one prediction
 set's straight discs as the kernel's arrays (``anyplan.prediction.collision`` uses it for the
-twist and tracked predictions and straight movers).
+twist and tracked predictions and straight movers). :func:`track_start_bounds` is the broad
+phase of the certified search for looping tracks (``WaypointMotion``): where each may first
+come near the robot.
 """
 
 from __future__ import annotations
@@ -147,6 +149,41 @@ def straight_contacts(ts: np.ndarray, xs: np.ndarray, ys: np.ndarray, t0: float,
             i += 1
         if out[k] < best:
             best = out[k]
+    return out
+
+
+@njit(cache=True)
+def track_start_bounds(kf: np.ndarray, lens: np.ndarray, rows: np.ndarray, speed: np.ndarray,
+                       radius: np.ndarray, gc: np.ndarray, pc: np.ndarray, vr: float,
+                       half_fine: float, reach0: float) -> np.ndarray:
+    """For each looping track ``rows[j]`` (keyframes ``kf[k, :lens[k]]``, rows (t, x, y), the
+    position at ``t mod period`` interpolated as ``np.interp`` does; speed bound ``speed[k]``
+    [m/s], radius ``radius[k]`` [m]), the start [s] of the first interval of the coarse times
+    ``gc`` whose gap bound, (d_c + d_c+1 - L dt) / 2 with L = ``vr`` + the track's speed, is at
+    most reach0 + radius + L ``half_fine`` + 1e-9 (1 + reach0 + L) [m]; inf if none. ``pc``
+    (len(gc), 2): the robot's positions [m]. Each track stops at its first such interval."""
+    m = gc.shape[0]
+    out = np.full(rows.shape[0], np.inf)
+    for j in range(rows.shape[0]):
+        k = rows[j]
+        nk = lens[k]
+        period = kf[k, nk - 1, 0]
+        lip = vr + speed[k]
+        need = reach0 + radius[k] + lip * half_fine + 1e-9 * (1.0 + reach0 + lip)
+        prev = 0.0
+        for c in range(m):
+            tm = gc[c] % period
+            i = 0
+            while i < nk and kf[k, i, 0] <= tm:
+                i += 1
+            i = min(max(i - 1, 0), nk - 2)
+            w = min(max((tm - kf[k, i, 0]) / (kf[k, i + 1, 0] - kf[k, i, 0]), 0.0), 1.0)
+            d = math.hypot(pc[c, 0] - (kf[k, i, 1] + w * (kf[k, i + 1, 1] - kf[k, i, 1])),
+                           pc[c, 1] - (kf[k, i, 2] + w * (kf[k, i + 1, 2] - kf[k, i, 2])))
+            if c > 0 and 0.5 * (prev + d - lip * (gc[c] - gc[c - 1])) <= need:
+                out[j] = gc[c - 1]
+                break
+            prev = d
     return out
 
 

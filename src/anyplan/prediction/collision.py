@@ -26,7 +26,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from anyplan.geometry.moving import first_contact, first_contact_growing
-from anyplan.prediction._contact_kernels import StraightDiscs
+from anyplan.prediction._contact_kernels import StraightDiscs, track_start_bounds
 from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
 from anyplan.world.motion import TrackMotion, UnicycleMotion, WaypointMotion
 
@@ -354,10 +354,6 @@ def _far_from_tracks(obstacles: Sequence[PredictedObstacle], gc: np.ndarray, pc:
         return lb > need + 0.5 * lip * float(dt.max()) + 1e-9 * (1.0 + need + lip)
 
 
-#: The keyframes of recent sets of pacing tracks, padded to one length (``_padded``).
-_PADDED: dict[tuple[int, ...], tuple[tuple[object, ...], Any]] = {}
-
-
 def _by_identity(cache: dict[tuple[int, ...], tuple[tuple[object, ...], Any]],
                  items: Sequence[object], build: Callable[[], Any]) -> Any:
     """``build()``, memoised in ``cache`` by the identity of ``items`` (the entry keeps them
@@ -373,20 +369,6 @@ def _by_identity(cache: dict[tuple[int, ...], tuple[tuple[object, ...], Any]],
     return out
 
 
-def _padded(motions: Sequence[WaypointMotion]) -> tuple[np.ndarray, np.ndarray]:
-    """The keyframes of ``motions`` stacked (n, K, 3) with K the longest, the rows past a
-    track's own end at time +inf (never <= a time), and each track's keyframe count (n,)."""
-    def build() -> tuple[np.ndarray, np.ndarray]:
-        lens = np.array([len(m.keyframes) for m in motions], dtype=np.int64)
-        kf = np.zeros((len(motions), int(lens.max()), 3))
-        kf[:, :, 0] = math.inf
-        for j, m in enumerate(motions):
-            kf[j, :lens[j]] = m.keyframes
-        return kf, lens
-
-    return _by_identity(_PADDED, motions, build)
-
-
 def _start_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, grid: np.ndarray,
                   gc: np.ndarray, pc: np.ndarray, vr: float, reach0: float) -> np.ndarray:
     """A lower bound of each obstacle's first uncertified grid time in :func:`_predict_uncached`
@@ -394,8 +376,8 @@ def _start_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, grid:
     all their tracks at the coarse times, -inf for the others. Before the first coarse interval
     whose bound is <= reach + L dt_max / 2 (+ 1e-9 m, far above the interpolations' rounding),
     the gap exceeds reach + L dt_max / 2, so no fine interval there is uncertified. The tracks
-    of every length are interpolated at once (keyframes padded, ``_padded``): per track the same
-    operations, element by element, as one track alone."""
+    (keyframes padded in the set's :class:`_Stack`) are interpolated by a compiled kernel that
+    stops each at its first such interval (:func:`track_start_bounds`)."""
     n = len(obstacles)
     out = np.full(n, -math.inf)
     out[far] = math.inf
@@ -403,22 +385,12 @@ def _start_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, grid:
         return out
     half_fine = 0.5 * float(np.diff(grid).max())
     _straight_bounds(obstacles, far, out, gc, pc, half_fine, vr, reach0)
-    ks = [k for k, o in enumerate(obstacles)
-          if not far[k] and o.growth is None and isinstance(o.motion, WaypointMotion)]
-    if not ks:
-        return out
-    kf, lens = _padded([obstacles[k].motion for k in ks])  # type: ignore[misc]
-    period = kf[np.arange(len(ks)), lens - 1, 0]
-    tm = np.mod(gc[None, :], period[:, None])  # (obstacles, coarse times)
-    i = np.clip((kf[:, None, :, 0] <= tm[:, :, None]).sum(axis=2) - 1, 0, (lens - 2)[:, None])
-    rows = np.arange(len(ks))[:, None]
-    a, b = kf[rows, i], kf[rows, i + 1]  # (obstacles, coarse times, 3)
-    w = np.clip((tm - a[:, :, 0]) / (b[:, :, 0] - a[:, :, 0]), 0.0, 1.0)
-    d = np.hypot(pc[None, :, 0] - (a[:, :, 1] + w * (b[:, :, 1] - a[:, :, 1])),
-                 pc[None, :, 1] - (a[:, :, 2] + w * (b[:, :, 2] - a[:, :, 2])))
-    lip = np.array([vr + _track(obstacles[k])[1] for k in ks])
-    out[np.array(ks)] = _first_uncertified(d, lip, np.array([obstacles[k].radius for k in ks]),
-                                           gc, half_fine, reach0)
+    stack = _stack(obstacles)
+    rows = np.flatnonzero(~far[stack.tracks])  # rows of the pacing tracks, not far
+    if len(rows):
+        out[stack.tracks[rows]] = track_start_bounds(
+            stack.kf, stack.lens, rows, stack.speed[stack.tracks], stack.radius[stack.tracks],
+            gc, np.ascontiguousarray(pc), float(vr), half_fine, float(reach0))
     return out
 
 
@@ -500,6 +472,9 @@ class _Stack:
         t0: (n,) each growth's t0 [s] (nan without growth).
         values: (n, K) each growth's values [m] on ``taus`` (when shared; else K = 0).
         growths: each obstacle's growth (None without), for the interpolation one by one.
+        tracks: indices of the looping tracks (``WaypointMotion``) without growth.
+        kf: (len(tracks), K, 3) their keyframes, padded to the longest (rows past a track's
+            end at time +inf); ``lens`` (len(tracks),) their keyframe counts.
     """
 
     boxes: np.ndarray
@@ -513,6 +488,9 @@ class _Stack:
     t0: np.ndarray
     values: np.ndarray
     growths: tuple[RadiusGrowth | None, ...]
+    tracks: np.ndarray
+    kf: np.ndarray
+    lens: np.ndarray
 
 
 #: Recent :class:`_Stack` records (``_stack``). A fallback ranking checks some twenty
@@ -547,8 +525,17 @@ def _build_stack(obstacles: Sequence[PredictedObstacle]) -> _Stack:
         for k, g in enumerate(growths):
             if g is not None:
                 values[k] = g.values
+    tracks = np.array([k for k, o in enumerate(obstacles)
+                       if o.growth is None and isinstance(o.motion, WaypointMotion)], dtype=np.int64)
+    keys = [obstacles[k].motion.keyframes for k in tracks]
+    lens = np.array([len(k) for k in keys], dtype=np.int64)
+    kf = np.zeros((len(keys), int(lens.max()) if len(keys) else 2, 3))
+    kf[:, :, 0] = math.inf
+    for j, k in enumerate(keys):
+        kf[j, :lens[j]] = k
     return _Stack(boxes, speed, rate, grown, np.array([o.radius for o in obstacles], dtype=float),
-                  straight, line, taus, t0, values, tuple(growths))  # type: ignore[arg-type]
+                  straight, line, taus, t0, values, tuple(growths),  # type: ignore[arg-type]
+                  tracks, kf, lens)
 
 
 def _growth_rows(stack: _Stack, rows: np.ndarray, t: np.ndarray) -> np.ndarray:
