@@ -15,7 +15,7 @@ absolute simulation times [s]. See ``docs/sequential.md`` ("Reference motions").
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -23,7 +23,7 @@ from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.shapes import Shape
 from anyplan.trajectory.kinds import SegmentKind
 from anyplan.trajectory.motion import brake_to_rest, come_to_rest, continue_from, plan_motion
-from anyplan.trajectory.trajectory import Segment, Trajectory
+from anyplan.trajectory.trajectory import CurveSegment, Segment, Trajectory, TurnSegment
 from anyplan.world.robot import RobotSpec, RobotState
 
 __all__ = ["HoldSegment", "ReferenceBuilder", "Departure", "WAIT_PREFIX"]
@@ -102,20 +102,58 @@ class Departure:
     state: RobotState
     t_start: float
     margin: float
+    #: The late departures built so far, by the identity of their path and squares (the entry
+    #: keeps them alive): the braking, where it rests, and the drive from there (see __call__).
+    _late: dict[tuple[int, ...], tuple[np.ndarray, tuple[Shape, ...], list[Segment], float,
+                                       RobotState, Trajectory]] = field(
+        default_factory=dict, compare=False, repr=False)
 
     def __call__(self, path: np.ndarray, extra_shapes: Sequence[Shape], delay_s: float) -> Trajectory:
         b, spec, state = self.builder, self.builder.spec, self.state
-        obst = b.obstacles.with_shapes(extra_shapes) if extra_shapes else b.obstacles
         if delay_s <= 0.0:
+            obst = b.obstacles.with_shapes(extra_shapes) if extra_shapes else b.obstacles
             return plan_motion(path, spec, state, obst, self.t_start, margin=self.margin,
                                grid_step=b.grid_step)
-        segs, t, rest, _ = come_to_rest(state, spec, obst, spec.radius + self.margin, self.t_start)
-        segs.append(HoldSegment(rest.x, rest.y, rest.theta, t, t + delay_s))
-        p = continue_from(np.array([rest.x, rest.y]), np.asarray(path, dtype=float), obst,
-                          spec.radius + self.margin)
-        tail = plan_motion(p, spec, rest, obst, t + delay_s, margin=self.margin,
-                           grid_step=b.grid_step)
-        return Trajectory(segs + tail.segments, kind=WAIT_PREFIX + tail.kind, feasible=tail.feasible,
-                          lower_bound_s=tail.lower_bound_s, polyline=tail.polyline,
-                          info=tail.info, certified_free=tail.certified_free,
-                          departs_s=t + delay_s)
+        # The braking, the place of rest and the drive from rest along the path do not depend on
+        # the delay: the drive is planned for the first delay asked, and for later ones its
+        # segments start later, each built as plan_motion builds it (t0 = the previous t1).
+        key = (id(path), *(id(x) for x in extra_shapes))
+        hit = self._late.get(key)
+        drive = None
+        if hit is not None and hit[0] is path and len(hit[1]) == len(extra_shapes) and all(
+                x is y for x, y in zip(hit[1], extra_shapes, strict=True)):
+            _, _, stop, t, rest, tail = hit
+            drive = _started_at(tail.segments, t + delay_s)
+        if drive is None:
+            obst = b.obstacles.with_shapes(extra_shapes) if extra_shapes else b.obstacles
+            stop, t, rest, _ = come_to_rest(state, spec, obst, spec.radius + self.margin,
+                                            self.t_start)
+            p = continue_from(np.array([rest.x, rest.y]), np.asarray(path, dtype=float), obst,
+                              spec.radius + self.margin)
+            tail = plan_motion(p, spec, rest, obst, t + delay_s, margin=self.margin,
+                               grid_step=b.grid_step)
+            self._late[key] = (path, tuple(extra_shapes), stop, t, rest, tail)
+            drive = tail.segments
+        hold = HoldSegment(rest.x, rest.y, rest.theta, t, t + delay_s)
+        return Trajectory([*stop, hold, *drive], kind=WAIT_PREFIX + tail.kind,
+                          feasible=tail.feasible, lower_bound_s=tail.lower_bound_s,
+                          polyline=tail.polyline, info=tail.info,
+                          certified_free=tail.certified_free, departs_s=t + delay_s)
+
+
+def _started_at(segments: Sequence[Segment], t0: float) -> list[Segment] | None:
+    """``segments`` (turns and curves, contiguous) moved to start at ``t0`` [s], each built as
+    :func:`~anyplan.trajectory.plan_motion` builds it there (its start the previous one's end,
+    its end its start plus its duration); None if one is of another kind."""
+    out: list[Segment] = []
+    for s in segments:
+        if type(s) is CurveSegment:
+            c = CurveSegment(s.curve, s.profile, t0)
+            c.max_speed = s.max_speed  # the curve's and the profile's, whenever it starts
+            out.append(c)
+        elif type(s) is TurnSegment:
+            out.append(TurnSegment(s.x, s.y, s.rotation, t0))
+        else:
+            return None
+        t0 = out[-1].t1
+    return out
