@@ -187,6 +187,102 @@ def track_start_bounds(kf: np.ndarray, lens: np.ndarray, rows: np.ndarray, speed
     return out
 
 
+@njit(cache=True)
+def _track_at(kf: np.ndarray, k: int, nk: int, t: float) -> tuple[int, float]:
+    """The segment of track ``k`` at absolute time ``t`` [s] (as ``np.interp`` at ``t mod
+    period`` picks it) and the index of the period that holds ``t``."""
+    period = kf[k, nk - 1, 0]
+    m = math.floor(t / period)
+    tm = t - m * period
+    if tm >= period:  # rounding: t is the next period's start
+        m += 1.0
+        tm = t - m * period
+    elif tm < 0.0:
+        m -= 1.0
+        tm = t - m * period
+    s = 0
+    while s + 2 < nk and kf[k, s + 1, 0] <= tm:
+        s += 1
+    return s, m
+
+
+@njit(cache=True)
+def track_contacts(ts: np.ndarray, xs: np.ndarray, ys: np.ndarray, t0: float, t1: float,
+                   kf: np.ndarray, lens: np.ndarray, rows: np.ndarray, speed: np.ndarray,
+                   reach: np.ndarray, until: np.ndarray, vr: float,
+                   first_only: bool) -> np.ndarray:
+    """First contact time [s] in [t0, t1] of the robot (samples ``ts``, ``xs``, ``ys``, linear
+    between them, speed at most ``vr`` [m/s], [t0, t1] within them) with each looping track
+    ``k = rows[j]`` (keyframes ``kf[k, :lens[k]]``, rows (t, x, y), repeated every period; an
+    open track jumps back to its first keyframe at each period's start; speed at most
+    ``speed[k]`` [m/s]), contact distance ``reach[k]`` [m], checked up to ``until[k]`` [s];
+    inf where there is none.
+
+    Between breakpoints (the samples, the keyframes, the periods' starts) both motions are
+    affine, so the first root of the squared gap is closed form (:func:`_first_root`). Where
+    the gap g [m] is wide the scan moves on by g / (vr + speed) at once (the gap cannot close
+    faster), never past a period's start. ``first_only``: as in :func:`straight_contacts`."""
+    n = ts.shape[0]
+    out = np.full(rows.shape[0], np.inf)
+    best = np.inf
+    for j in range(rows.shape[0]):
+        k = rows[j]
+        nk = lens[k]
+        period = kf[k, nk - 1, 0]
+        t_end = min(t1, until[k])
+        if t_end < t0:
+            continue
+        rk = reach[k] + CONTACT_EPS
+        lip = vr + speed[k]
+        p = t0
+        i = min(max(int(np.searchsorted(ts, p, side="right")) - 1, 0), n - 2)
+        s, m = _track_at(kf, k, nk, p)
+        while True:
+            if first_only and p >= best:
+                break
+            base = m * period
+            ta, tb = base + kf[k, s, 0], base + kf[k, s + 1, 0]
+            q = min(ts[i + 1], tb, t_end)
+            # the robot on its sample interval i (np.interp's formula), the track on segment s
+            w = (xs[i + 1] - xs[i]) / (ts[i + 1] - ts[i])
+            u = (ys[i + 1] - ys[i]) / (ts[i + 1] - ts[i])
+            ox = (kf[k, s + 1, 1] - kf[k, s, 1]) / (kf[k, s + 1, 0] - kf[k, s, 0])
+            oy = (kf[k, s + 1, 2] - kf[k, s, 2]) / (kf[k, s + 1, 0] - kf[k, s, 0])
+            dpx = w * (p - ts[i]) + xs[i] - (ox * (p - ta) + kf[k, s, 1])
+            dpy = u * (p - ts[i]) + ys[i] - (oy * (p - ta) + kf[k, s, 2])
+            gap = math.sqrt(dpx * dpx + dpy * dpy) - rk
+            if gap > 0.0 and lip > 0.0 and p + gap / lip > q:
+                nxt = min(p + gap / lip, base + period)  # no contact before it
+                if nxt >= t_end:
+                    break
+                p = nxt
+            else:
+                h = q - p
+                r = -1.0
+                if h > 0.0:
+                    dqx = w * (q - ts[i]) + xs[i] - (ox * (q - ta) + kf[k, s, 1])
+                    dqy = u * (q - ts[i]) + ys[i] - (oy * (q - ta) + kf[k, s, 2])
+                    r = _first_root(dpx, dpy, (dqx - dpx) / h, (dqy - dpy) / h, rk, 0.0, h)
+                elif gap <= 0.0:
+                    r = 0.0
+                if r >= 0.0:
+                    out[j] = min(p + r, t_end)
+                    break
+                if q >= t_end:
+                    break
+                p = q
+            while i < n - 2 and ts[i + 1] <= p:
+                i += 1
+            while p >= m * period + kf[k, s + 1, 0]:  # the segment's end: the next one
+                s += 1
+                if s == nk - 1:  # the period's end: the next period's first segment
+                    s = 0
+                    m += 1.0
+        if out[j] < best:
+            best = out[j]
+    return out
+
+
 @dataclass(frozen=True)
 class StraightDiscs:
     """The discs of one prediction set on straight lines (without growth, or with one on the

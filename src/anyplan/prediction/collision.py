@@ -26,7 +26,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from anyplan.geometry.moving import first_contact, first_contact_growing
-from anyplan.prediction._contact_kernels import StraightDiscs, track_start_bounds
+from anyplan.prediction._contact_kernels import StraightDiscs, track_contacts, track_start_bounds
 from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
 from anyplan.world.motion import TrackMotion, UnicycleMotion, WaypointMotion
 
@@ -202,18 +202,24 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
         return _certified_hits(motion, obstacles, robot_radius, t0, t1, margin, tol, None,
                                first_only)
     lines = _by_identity(_LINES, obstacles, lambda: StraightDiscs.of(obstacles))
-    if not len(lines.index):
+    stack = _stack(obstacles)
+    if not len(lines.index) and not len(stack.tracks):
         return _certified_hits(motion, obstacles, robot_radius, t0, t1, margin, tol, sample_dt,
                                first_only)
-    # every obstacle straight: the robot is not sampled after the last prediction's end
-    stop = float(lines.until.max()) if not lines.rest else math.inf
+    rest = sorted(set(lines.rest) - set(stack.tracks.tolist()))
+    # every obstacle in closed form: the robot is not sampled after the last prediction's end
+    stop = max(float(lines.until.max(initial=-math.inf)),
+               float(stack.until[stack.tracks].max(initial=-math.inf))) if not rest else math.inf
     sampled = SampledMotion(motion, t0, t1, sample_dt, stop)
-    out = _straight_hits(motion, sampled, obstacles, lines, robot_radius + margin, t0, t1,
-                         first_only)
-    if lines.rest:  # each obstacle's contact is its own: the same answer with or without the others
-        rest = [obstacles[k] for k in lines.rest]
-        out += _certified_hits(motion, rest, robot_radius, t0, t1, margin, tol, sample_dt,
-                               first_only, sampled)
+    reach0 = robot_radius + margin
+    out = []
+    if len(lines.index):
+        out += _straight_hits(motion, sampled, obstacles, lines, reach0, t0, t1, first_only)
+    if len(stack.tracks):
+        out += _track_hits(motion, sampled, obstacles, stack, reach0, t0, t1, first_only)
+    if rest:  # each obstacle's contact is its own: the same answer with or without the others
+        out += _certified_hits(motion, [obstacles[k] for k in rest], robot_radius, t0, t1,
+                               margin, tol, sample_dt, first_only, sampled)
     out.sort(key=lambda c: c.t)
     return out[:1] if first_only else out
 
@@ -231,9 +237,31 @@ def _straight_hits(motion: TimedMotion, sampled: SampledMotion,
     times = lines.first_contacts(sampled._t, sampled._x, sampled._y,
                                  reach0 + sampled.error_bound, t0, min(t1, sampled.t_end),
                                  first_only)
+    return _hits(motion, obstacles, lines.index, times)
+
+
+def _track_hits(motion: TimedMotion, sampled: SampledMotion,
+                obstacles: Sequence[PredictedObstacle], stack: _Stack, reach0: float, t0: float,
+                t1: float, first_only: bool) -> list[PredictedCollision]:
+    """First contacts with the looping tracks of ``stack`` (``WaypointMotion`` without growth),
+    exact on the robot's samples with the contact distance enlarged by their error bound (so
+    never later than the true motion's), jumps of open tracks included, by
+    :func:`track_contacts`."""
+    rows = stack.tracks
+    times = track_contacts(sampled._t, sampled._x, sampled._y, float(t0),
+                           float(min(t1, sampled.t_end)), stack.kf,
+                           stack.lens, np.arange(len(rows)), stack.speed[rows],
+                           reach0 + sampled.error_bound + stack.radius[rows], stack.until[rows],
+                           float(sampled.max_speed), bool(first_only))
+    return _hits(motion, obstacles, rows, times)
+
+
+def _hits(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], index: np.ndarray,
+          times: np.ndarray) -> list[PredictedCollision]:
+    """The contacts ``times`` [s] (inf: none) of the obstacles ``index`` as records."""
     out = []
     for j in np.flatnonzero(times < math.inf):
-        o, tc = obstacles[int(lines.index[j])], float(times[j])
+        o, tc = obstacles[int(index[j])], float(times[j])
         ta = np.array([tc])
         out.append(PredictedCollision(o.name, tc, motion.positions(ta)[0], o.positions(ta)[0],
                                       float(o.radius_at(tc))))
@@ -472,6 +500,7 @@ class _Stack:
         t0: (n,) each growth's t0 [s] (nan without growth).
         values: (n, K) each growth's values [m] on ``taus`` (when shared; else K = 0).
         growths: each obstacle's growth (None without), for the interpolation one by one.
+        until: (n,) the predictions' horizons [s].
         tracks: indices of the looping tracks (``WaypointMotion``) without growth.
         kf: (len(tracks), K, 3) their keyframes, padded to the longest (rows past a track's
             end at time +inf); ``lens`` (len(tracks),) their keyframe counts.
@@ -488,6 +517,7 @@ class _Stack:
     t0: np.ndarray
     values: np.ndarray
     growths: tuple[RadiusGrowth | None, ...]
+    until: np.ndarray
     tracks: np.ndarray
     kf: np.ndarray
     lens: np.ndarray
@@ -535,7 +565,7 @@ def _build_stack(obstacles: Sequence[PredictedObstacle]) -> _Stack:
         kf[j, :lens[j]] = k
     return _Stack(boxes, speed, rate, grown, np.array([o.radius for o in obstacles], dtype=float),
                   straight, line, taus, t0, values, tuple(growths),  # type: ignore[arg-type]
-                  tracks, kf, lens)
+                  np.array([o.until for o in obstacles], dtype=float), tracks, kf, lens)
 
 
 def _growth_rows(stack: _Stack, rows: np.ndarray, t: np.ndarray) -> np.ndarray:
