@@ -76,10 +76,11 @@ def test_an_open_track_that_jumps_onto_the_robot_is_a_contact_at_the_jump():
     track = WaypointMotion(np.array([[0.0, 4.0, 5.0], [1.0, 4.0, 10.0], [period, 6.0, 10.0]]))
     assert track.is_open
     ob = PredictedObstacle("J", 0.3, track)
-    collision._MEMO.clear()
-    hit = first_collision(MOTION, [ob], 0.3, margin=0.05, sample_dt=DT)
-    assert hit is not None and hit.t == pytest.approx(period, abs=1e-9)
-    np.testing.assert_allclose(hit.obstacle_position, [4.0, 5.0], atol=1e-9)
+    for sample_dt in (DT, None):  # closed form on the samples; the certified search
+        collision._MEMO.clear()
+        hit = first_collision(MOTION, [ob], 0.3, margin=0.05, sample_dt=sample_dt)
+        assert hit is not None and hit.t == pytest.approx(period, abs=1e-9)
+        np.testing.assert_allclose(hit.obstacle_position, [4.0, 5.0], atol=1e-9)
     t_ref, _ = _brute(ob)
     assert t_ref is not None and period - 1e-4 - 1e-9 <= t_ref <= period + 1e-4
 

@@ -154,14 +154,16 @@ def straight_contacts(ts: np.ndarray, xs: np.ndarray, ys: np.ndarray, t0: float,
 
 @njit(cache=True)
 def track_start_bounds(kf: np.ndarray, lens: np.ndarray, rows: np.ndarray, speed: np.ndarray,
-                       radius: np.ndarray, gc: np.ndarray, pc: np.ndarray, vr: float,
-                       half_fine: float, reach0: float) -> np.ndarray:
+                       radius: np.ndarray, opened: np.ndarray, gc: np.ndarray, pc: np.ndarray,
+                       vr: float, half_fine: float, reach0: float) -> np.ndarray:
     """For each looping track ``rows[j]`` (keyframes ``kf[k, :lens[k]]``, rows (t, x, y), the
     position at ``t mod period`` interpolated as ``np.interp`` does; speed bound ``speed[k]``
     [m/s], radius ``radius[k]`` [m]), the start [s] of the first interval of the coarse times
     ``gc`` whose gap bound, (d_c + d_c+1 - L dt) / 2 with L = ``vr`` + the track's speed, is at
     most reach0 + radius + L ``half_fine`` + 1e-9 (1 + reach0 + L) [m]; inf if none. ``pc``
-    (len(gc), 2): the robot's positions [m]. Each track stops at its first such interval."""
+    (len(gc), 2): the robot's positions [m]. Each track stops at its first such interval; an
+    interval that holds a period's start of an open track (``opened[k]``: it jumps back there)
+    counts as one, since the speed bound does not hold across the jump."""
     m = gc.shape[0]
     out = np.full(rows.shape[0], np.inf)
     for j in range(rows.shape[0]):
@@ -180,7 +182,9 @@ def track_start_bounds(kf: np.ndarray, lens: np.ndarray, rows: np.ndarray, speed
             w = min(max((tm - kf[k, i, 0]) / (kf[k, i + 1, 0] - kf[k, i, 0]), 0.0), 1.0)
             d = math.hypot(pc[c, 0] - (kf[k, i, 1] + w * (kf[k, i + 1, 1] - kf[k, i, 1])),
                            pc[c, 1] - (kf[k, i, 2] + w * (kf[k, i + 1, 2] - kf[k, i, 2])))
-            if c > 0 and 0.5 * (prev + d - lip * (gc[c] - gc[c - 1])) <= need:
+            if c > 0 and (0.5 * (prev + d - lip * (gc[c] - gc[c - 1])) <= need or (
+                    opened[k] and (tm == 0.0 or math.floor(gc[c] / period)
+                                   != math.floor(gc[c - 1] / period)))):
                 out[j] = gc[c - 1]
                 break
             prev = d

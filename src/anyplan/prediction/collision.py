@@ -312,9 +312,13 @@ def _certified_hits(motion: TimedMotion, obstacles: Sequence[PredictedObstacle],
         if o.until < t0 or far[k]:
             return None  # predicted only before the interval, or never near the robot
         reach = robot_radius + o.radius + margin + extra
-        if len(ic) < len(grid) and np.all(gap_bounds(o, gc, pc) > reach):
+        jumps = _jump_times(o, grid[0], grid[-1])
+        if not len(jumps) and len(ic) < len(grid) and np.all(gap_bounds(o, gc, pc) > reach):
             return None
-        bad = np.flatnonzero(gap_bounds(o, grid, p) <= reach)
+        low = gap_bounds(o, grid, p) <= reach
+        # the speed bound does not hold across a jump: an interval that holds one is uncertified
+        low[np.clip(np.searchsorted(grid, jumps) - 1, 0, len(low) - 1)] = True
+        bad = np.flatnonzero(low)
         if o.until < t1:  # intervals that start after the prediction's horizon do not count
             bad = bad[grid[bad] <= o.until]
         return float(grid[bad[0]]) if len(bad) else None
@@ -342,12 +346,16 @@ def _certified_hits(motion: TimedMotion, obstacles: Sequence[PredictedObstacle],
         o = obstacles[k]
         reach = robot_radius + o.radius + margin + extra
         t1o = min(t1, o.until)
-        if o.growth is None:
-            tc = first_contact(motion.positions, o.positions, vr + o.max_speed, reach, ts, t1o,
-                               tol=tol)
-        else:
-            tc = first_contact_growing(motion.positions, o.positions, vr + o.max_speed, reach,
-                                       o.growth.at, o.growth.rate, ts, t1o, tol=tol)
+        tc = None
+        for a, b in _continuous(o, ts, t1o):  # the speed bound holds between jumps only
+            if o.growth is None:
+                tc = first_contact(motion.positions, o.positions, vr + o.max_speed, reach, a, b,
+                                   tol=tol)
+            else:
+                tc = first_contact_growing(motion.positions, o.positions, vr + o.max_speed,
+                                           reach, o.growth.at, o.growth.rate, a, b, tol=tol)
+            if tc is not None:
+                break
         if tc is None:
             continue
         ta = np.array([tc])
@@ -356,6 +364,24 @@ def _certified_hits(motion: TimedMotion, obstacles: Sequence[PredictedObstacle],
         out.append(hit)
         out.sort(key=lambda c: c.t)
     return out
+
+
+def _jump_times(o: PredictedObstacle, t0: float, t1: float) -> np.ndarray:
+    """The times [s] in [t0, t1] at which ``o``'s motion jumps (an open track's periods)."""
+    return np.array([j.time for j in o.motion.jumps(t0, t1) if t0 <= j.time <= t1], dtype=float)
+
+
+#: [s] a piece of :func:`_continuous` ends this long before a jump (the position there is the
+#: jump's left limit to within the obstacle's speed times it: far below any search tolerance).
+_BEFORE_JUMP = 1e-9
+
+
+def _continuous(o: PredictedObstacle, t0: float, t1: float) -> list[tuple[float, float]]:
+    """[t0, t1] [s] cut at the jumps of ``o``'s motion into pieces on which it is continuous:
+    each jump starts a piece (a piece may be the jump's instant alone)."""
+    js = [float(j) for j in _jump_times(o, t0, t1) if j > t0]
+    ends = [*(j - _BEFORE_JUMP for j in js), t1]
+    return [(a, max(a, b)) for a, b in zip([t0, *js], ends, strict=True)]
 
 
 def _far_from_tracks(obstacles: Sequence[PredictedObstacle], gc: np.ndarray, pc: np.ndarray,
@@ -418,7 +444,7 @@ def _start_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, grid:
     if len(rows):
         out[stack.tracks[rows]] = track_start_bounds(
             stack.kf, stack.lens, rows, stack.speed[stack.tracks], stack.radius[stack.tracks],
-            gc, np.ascontiguousarray(pc), float(vr), half_fine, float(reach0))
+            stack.opened, gc, np.ascontiguousarray(pc), float(vr), half_fine, float(reach0))
     return out
 
 
@@ -503,7 +529,8 @@ class _Stack:
         until: (n,) the predictions' horizons [s].
         tracks: indices of the looping tracks (``WaypointMotion``) without growth.
         kf: (len(tracks), K, 3) their keyframes, padded to the longest (rows past a track's
-            end at time +inf); ``lens`` (len(tracks),) their keyframe counts.
+            end at time +inf); ``lens`` (len(tracks),) their keyframe counts; ``opened``
+            (len(tracks),) True for an open track (it jumps back at each period's start).
     """
 
     boxes: np.ndarray
@@ -521,6 +548,7 @@ class _Stack:
     tracks: np.ndarray
     kf: np.ndarray
     lens: np.ndarray
+    opened: np.ndarray
 
 
 #: Recent :class:`_Stack` records (``_stack``). A fallback ranking checks some twenty
@@ -565,7 +593,8 @@ def _build_stack(obstacles: Sequence[PredictedObstacle]) -> _Stack:
         kf[j, :lens[j]] = k
     return _Stack(boxes, speed, rate, grown, np.array([o.radius for o in obstacles], dtype=float),
                   straight, line, taus, t0, values, tuple(growths),  # type: ignore[arg-type]
-                  np.array([o.until for o in obstacles], dtype=float), tracks, kf, lens)
+                  np.array([o.until for o in obstacles], dtype=float), tracks, kf, lens,
+                  np.array([obstacles[k].motion.is_open for k in tracks], dtype=np.bool_))
 
 
 def _growth_rows(stack: _Stack, rows: np.ndarray, t: np.ndarray) -> np.ndarray:
