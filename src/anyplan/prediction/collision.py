@@ -237,7 +237,7 @@ def _straight_hits(motion: TimedMotion, sampled: SampledMotion,
     times = lines.first_contacts(sampled._t, sampled._x, sampled._y,
                                  reach0 + sampled.error_bound, t0, min(t1, sampled.t_end),
                                  first_only)
-    return _hits(motion, obstacles, lines.index, times)
+    return _hits(motion, obstacles, lines.index, times, first_only)
 
 
 def _track_hits(motion: TimedMotion, sampled: SampledMotion,
@@ -253,14 +253,18 @@ def _track_hits(motion: TimedMotion, sampled: SampledMotion,
                            stack.lens, np.arange(len(rows)), stack.speed[rows],
                            reach0 + sampled.error_bound + stack.radius[rows], stack.until[rows],
                            float(sampled.max_speed), bool(first_only))
-    return _hits(motion, obstacles, rows, times)
+    return _hits(motion, obstacles, rows, times, first_only)
 
 
 def _hits(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], index: np.ndarray,
-          times: np.ndarray) -> list[PredictedCollision]:
-    """The contacts ``times`` [s] (inf: none) of the obstacles ``index`` as records."""
+          times: np.ndarray, first_only: bool) -> list[PredictedCollision]:
+    """The contacts ``times`` [s] (inf: none) of the obstacles ``index`` as records (with
+    ``first_only``, the earliest alone; the first in ``index`` order on a tie)."""
     out = []
-    for j in np.flatnonzero(times < math.inf):
+    found = np.flatnonzero(times < math.inf)
+    if first_only and len(found):
+        found = found[np.argmin(times[found]):][:1]
+    for j in found:
         o, tc = obstacles[int(index[j])], float(times[j])
         ta = np.array([tc])
         out.append(PredictedCollision(o.name, tc, motion.positions(ta)[0], o.positions(ta)[0],
