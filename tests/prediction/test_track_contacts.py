@@ -4,7 +4,6 @@ against brute force on a fine grid; the jumps of open tracks included."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -79,7 +78,8 @@ def test_an_open_track_that_jumps_onto_the_robot_is_a_contact_at_the_jump():
     for sample_dt in (DT, None):  # closed form on the samples; the certified search
         collision._MEMO.clear()
         hit = first_collision(MOTION, [ob], 0.3, margin=0.05, sample_dt=sample_dt)
-        assert hit is not None and hit.t == pytest.approx(period, abs=1e-9)
+        # (the certified search starts 1 ns after a jump: the positions' wrap may lag it)
+        assert hit is not None and period - 1e-12 <= hit.t <= period + 2e-9
         np.testing.assert_allclose(hit.obstacle_position, [4.0, 5.0], atol=1e-9)
     t_ref, _ = _brute(ob)
     assert t_ref is not None and period - 1e-4 - 1e-9 <= t_ref <= period + 1e-4

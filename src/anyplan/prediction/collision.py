@@ -375,17 +375,20 @@ def _jump_times(o: PredictedObstacle, t0: float, t1: float) -> np.ndarray:
     return np.array([j.time for j in o.motion.jumps(t0, t1) if t0 <= j.time <= t1], dtype=float)
 
 
-#: [s] a piece of :func:`_continuous` ends this long before a jump (the position there is the
-#: jump's left limit to within the obstacle's speed times it: far below any search tolerance).
+#: [s] a piece of :func:`_continuous` starts this long after a jump and the one before ends
+#: this long before it: a jump's time (n times the period) and the wrap of the positions
+#: (``t mod period``) may differ by rounding. The position there is the jump's limit to within
+#: the obstacle's speed times it, far below any search tolerance.
 _BEFORE_JUMP = 1e-9
 
 
 def _continuous(o: PredictedObstacle, t0: float, t1: float) -> list[tuple[float, float]]:
     """[t0, t1] [s] cut at the jumps of ``o``'s motion into pieces on which it is continuous:
-    each jump starts a piece (a piece may be the jump's instant alone)."""
+    each jump starts a piece (a piece may be a single instant)."""
     js = [float(j) for j in _jump_times(o, t0, t1) if j > t0]
+    starts = [t0, *(min(j + _BEFORE_JUMP, t1) for j in js)]
     ends = [*(j - _BEFORE_JUMP for j in js), t1]
-    return [(a, max(a, b)) for a, b in zip([t0, *js], ends, strict=True)]
+    return [(a, max(a, b)) for a, b in zip(starts, ends, strict=True)]
 
 
 def _far_from_tracks(obstacles: Sequence[PredictedObstacle], gc: np.ndarray, pc: np.ndarray,
