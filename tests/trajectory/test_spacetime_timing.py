@@ -81,6 +81,34 @@ def _pts(s):
     return np.column_stack([1.0 + s, np.full(s.shape, 2.0)])
 
 
+@pytest.mark.parametrize("period", [3.0, 3.013, 3.04, 2.999999999, 1.01])
+@pytest.mark.parametrize("shared", [False, True])
+def test_stmap_is_conservative_where_an_open_track_jumps(period, shared):
+    """An open track starts on the route, leaves it, and at each period's end jumps back onto
+    it: free cells have no contact over the whole row, the rows where it jumps included (the
+    jump times n p and the positions' wrap, t mod p, differ by rounding for some periods)."""
+    from anyplan.world.motion import WaypointMotion
+
+    track = WaypointMotion(np.array([[0.0, 5.0, 2.0], [0.4, 5.0, 3.9], [period, 8.0, 3.9]]))
+    ob = PredictedObstacle("O", 0.3, track)
+    length, ds, h, margin = 8.0, 0.05, 0.05, 0.05
+    m = build_stmap(_pts, length, [ob], SPEC.radius, 0.0, 20.0, margin=margin, ds=ds, h=h,
+                    rows=RowCache(0.0, h) if shared else None)
+    reach = SPEC.radius + 0.3 + margin
+    g = m.grid()
+    ts = (np.arange(g.shape[0])[:, None] + np.linspace(0.0, 1.0, 11)[None, :]) * h  # rows x 11
+    q = ob.positions(ts.ravel()).reshape(g.shape[0], 11, 2)
+    ss = (np.arange(g.shape[1])[:, None] + np.linspace(0.0, 1.0, 6)[None, :]) * ds
+    p = _pts(np.minimum(ss.ravel(), length)).reshape(g.shape[1], 6, 2)
+    # the gap of every (row, cell) at 11 x 6 sample pairs, rows in chunks
+    for j0 in range(0, g.shape[0], 50):
+        qq = q[j0:j0 + 50]
+        d = np.hypot(qq[:, None, :, None, 0] - p[None, :, None, :, 0],
+                     qq[:, None, :, None, 1] - p[None, :, None, :, 1]).min(axis=(2, 3))
+        assert not np.any((d <= reach) & ~g[j0:j0 + 50])
+    assert m.blockers == ["O"]
+
+
 def test_shared_rows_give_the_same_map_on_their_grid_and_a_conservative_one_off_it():
     # Maps of several paths built with one RowCache: a map starting on the cache's grid is
     # the map built without it; one starting between rows starts at the row

@@ -277,6 +277,42 @@ class STMap:
         return out
 
 
+def _jumps(o: Any, t0: float, t1: float) -> list[float]:
+    """Times [s] in (t0, t1] at which the position of ``o`` jumps (an open track's periods)."""
+    m = getattr(o, "motion", None)
+    fn = getattr(m, "jumps", None)
+    return [] if fn is None else [j.time for j in fn(t0, t1) if t0 < j.time <= t1]
+
+
+#: [s] how far from a reported jump time a motion's positions may still be on its other side
+#: (the jump time n p and the wrap of ``t mod p`` differ by rounding): the pieces overlap by it.
+_JUMP_SLACK = 1e-9
+
+
+def _pieces(o: Any, t_map: float, h: float, nfill: int, reach: np.ndarray, speed: float
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """An obstacle whose position jumps within the rows as one entry per piece between its
+    jumps: centres (pieces, rows, 2) [m] at each row's middle clamped into the piece (just
+    after the jump it starts with, just before the one it ends with), contact distances
+    (pieces, rows) [m] ``reach`` grown by v h / 2 (a time of the piece in the row lies within
+    h of the clamped one, up to the slack, and the motion is continuous on the piece), none
+    (-1) in rows outside the piece. Consecutive rows' clamped times are at most 1.5 h apart
+    (the spread :func:`_fill` is given)."""
+    t_end = t_map + nfill * h
+    js = _jumps(o, t_map, t_end)
+    row0 = t_map + h * np.arange(nfill)
+    t_mid = row0 + 0.5 * h
+    grow = 0.5 * speed * h + speed * 4.0 * _JUMP_SLACK + 1e-9
+    qs, rs = [], []
+    for a, b in zip([t_map, *js], [*js, t_end], strict=True):
+        lo = a + _JUMP_SLACK if a in js else a
+        hi = max(lo, b - _JUMP_SLACK) if b in js else max(lo, b)
+        qs.append(np.asarray(o.positions(np.clip(t_mid, lo, hi)), dtype=float).reshape(-1, 2))
+        inside = (row0 + h >= a - _JUMP_SLACK) & (row0 <= b + _JUMP_SLACK)
+        rs.append(np.where(inside, reach + grow, -1.0))
+    return np.stack(qs), np.stack(rs)
+
+
 def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_radius: float,
                 t_map: float, horizon_s: float, *, margin: float = 0.0, ds: float = 0.05,
                 h: float = 0.05, free_tail_m: float = 0.0, rows: RowCache | None = None) -> STMap:
@@ -336,11 +372,26 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     speed = np.array([float(o.max_speed) for o in obstacles])
     # All obstacles at once, element by element the same operations as one at a time.
     reach = robot_radius + r_max + margin + 0.5 * ds + (0.5 * speed)[:, None] * h
+    spread = speed * h
+    owner = np.arange(len(obstacles))
+    t_end = t_map + nfill * h
+    jumpy = [k for k, o in enumerate(obstacles) if _jumps(o, t_map, t_end)]
+    if jumpy:  # each such obstacle as its pieces between jumps (_pieces)
+        parts = [_pieces(obstacles[k], t_map, h, nfill, reach[k], float(speed[k])) for k in jumpy]
+        keep = np.setdiff1d(owner, jumpy)
+        owner = np.concatenate([keep, *(np.full(len(pc[0]), k) for k, pc in zip(jumpy, parts,
+                                                                               strict=True))])
+        qx = np.concatenate([qx[keep], *(pc[0][:, :, 0] for pc in parts)])
+        qy = np.concatenate([qy[keep], *(pc[0][:, :, 1] for pc in parts)])
+        reach = np.concatenate([reach[keep], *(pc[1] for pc in parts)])
+        spread = np.concatenate([spread[keep], *(np.full(len(pc[0]), 1.5 * speed[k] * h + 1e-8)
+                                                 for k, pc in zip(jumpy, parts, strict=True))])
     away = np.min(np.hypot(qx - gx, qy - gy) - grad - reach, axis=1) > 0.0  # never near the path
     near = np.flatnonzero(~away)
     if len(near):
         hit = _fill(out, px, py, cx, cy, crad, np.ascontiguousarray(qx[near]),
                     np.ascontiguousarray(qy[near]), np.ascontiguousarray(reach[near]),
-                    speed[near] * h, _CHUNK, n_free, sx, sy, srad, _GROUP)
-        blockers = [str(obstacles[k].name) for k, hh in zip(near, hit, strict=True) if hh]
+                    spread[near], _CHUNK, n_free, sx, sy, srad, _GROUP)
+        hits = {int(owner[k]) for k, hh in zip(near, hit, strict=True) if hh}
+        blockers = [str(obstacles[k].name) for k in sorted(hits)]
     return STMap(out, t_map, h, ds, length, blockers, nrow)
