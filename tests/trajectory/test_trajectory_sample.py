@@ -72,3 +72,25 @@ def test_sample_equals_the_time_by_time_segment_lookup(kind, seed, n, order, nan
     p = tr.positions(t)
     assert p.shape == (len(t), 2) and p[:, 0].tobytes() == want[0].tobytes()
     assert p[:, 1].tobytes() == want[1].tobytes()
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(1, 60),
+       order=st.sampled_from(["sorted", "random", "reversed"]))
+def test_curve_sampling_from_the_last_interval_is_each_time_alone(seed, n, order):
+    """The curve's sampling starts each lookup from the previous time's interval: bit for bit
+    what each time sampled alone gives (a lookup from scratch), whatever the order; x and y
+    alone are the full sample's."""
+    from anyplan.trajectory.trajectory import CurveSegment
+
+    rng = np.random.default_rng(seed)
+    pts = np.cumsum(rng.uniform((0.5, -2.0), (3.0, 2.0), (int(rng.integers(2, 6)), 2)), axis=0)
+    tr = plan_motion(np.vstack([[0.0, 0.0], pts]), SPEC, RobotState(0.0, 0.0, 0.3, 0.5, 0.0),
+                     ObstacleSet([]), 0.0)
+    seg = next(s for s in tr.segments if isinstance(s, CurveSegment))
+    tau = rng.uniform(-0.5, seg.t1 - seg.t0 + 0.5, n)
+    tau = {"sorted": np.sort(tau), "reversed": np.sort(tau)[::-1], "random": tau}[order]
+    got = seg.curve.sample_profile(seg._prof, tau)
+    alone = np.column_stack([seg.curve.sample_profile(seg._prof, tau[j:j + 1]) for j in range(n)])
+    assert got.tobytes() == alone.tobytes()
+    assert seg.curve.sample_profile(seg._prof, tau, False).tobytes() == got[:2].tobytes()

@@ -34,6 +34,12 @@ class Segment:
         """(x, y, theta, v, omega) at times ``t`` (clamped to the segment)."""
         raise NotImplementedError
 
+    def xy(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """x, y [m] at times ``t`` (N,) [s], as :meth:`sample` gives them (a segment may
+        compute them alone, faster)."""
+        out = self.sample(t)
+        return out[0], out[1]
+
     def path_points(self, step: float) -> np.ndarray:
         """Geometric points (M, 2) [m] visited by the segment."""
         raise NotImplementedError

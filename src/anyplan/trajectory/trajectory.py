@@ -67,6 +67,11 @@ class CurveSegment(Segment):
             return out[0], out[1], out[2], out[3], out[4]
         return tuple(o.reshape(t.shape) for o in out)
 
+    def xy(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """x, y [m] at times ``t`` (N,) [s]: :meth:`sample`'s first two, without the others."""
+        out = self.curve.sample_profile(self._prof, np.asarray(t, dtype=float) - self.t0, False)
+        return out[0], out[1]
+
     def path_points(self, step: float) -> np.ndarray:
         return self.curve.samples(step)
 
@@ -181,9 +186,17 @@ class Trajectory:
             Arrays x [m], y [m], theta [rad], v [m/s], omega [rad/s] of the shape of ``t``.
         """
         t = np.asarray(t, dtype=float)
-        flat = t.ravel()
+        out = self._evaluate(t.ravel(), True)
+        if t.ndim == 1:
+            return out[0], out[1], out[2], out[3], out[4]
+        return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
+
+    def _evaluate(self, flat: np.ndarray, full: bool) -> list[np.ndarray]:
+        """The five arrays of :meth:`sample` at the times ``flat`` (N,) [s], or x and y alone
+        when not ``full`` (each segment's :meth:`~Segment.xy`)."""
         segs = self.segments
         nseg = len(segs)
+        nout = 5 if full else 2
         span = _span(flat)
         cuts: list[int] | None = None
         if span is None:  # no times, or a NaN among them: every segment found time by time
@@ -200,10 +213,14 @@ class Trajectory:
                 [0, *np.searchsorted(flat, self._starts[1:], side="left").tolist(), flat.size]
             if not single and cuts is None:
                 idx = np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0, nseg - 1)
+
+        def at(seg: Segment, times: np.ndarray) -> tuple[np.ndarray, ...]:
+            return seg.sample(times) if full else seg.xy(times)
+
         if single:
             # one segment serves every time (the common case: a control step or one query)
             seg = segs[k0]
-            vals = seg.sample(flat)
+            vals = at(seg, flat)
             # our segments return fresh, separate arrays; copy others' (they may share memory)
             if type(seg) in _FRESH:
                 out = [np.asarray(v, dtype=float).reshape(flat.shape) for v in vals]
@@ -212,35 +229,34 @@ class Trajectory:
         elif cuts is not None:
             # times in order: segment k serves the slice from the first time at or after its
             # start to the first at or after the next one's (searchsorted(starts, t, "right") - 1)
-            out = [np.empty(flat.shape) for _ in range(5)]
+            out = [np.empty(flat.shape) for _ in range(nout)]
             for k in range(nseg):
                 lo, hi = cuts[k], cuts[k + 1]
                 if lo < hi:
-                    vals = segs[k].sample(flat[lo:hi])
+                    vals = at(segs[k], flat[lo:hi])
                     for o, val in zip(out, vals, strict=True):
                         o[lo:hi] = val
         else:
-            out = [np.empty(flat.shape) for _ in range(5)]
+            out = [np.empty(flat.shape) for _ in range(nout)]
             for k in np.unique(idx):
                 m = idx == k
-                vals = segs[k].sample(flat[m])
+                vals = at(segs[k], flat[m])
                 for o, val in zip(out, vals, strict=True):
                     o[m] = val
-        if span is None or span[1] >= segs[-1].t1:  # at rest after the end
+        if full and (span is None or span[1] >= segs[-1].t1):  # at rest after the end
             after = flat >= segs[-1].t1
             if after.any():
                 out[3][after] = 0.0
                 out[4][after] = 0.0
-        if t.ndim == 1:
-            return out[0], out[1], out[2], out[3], out[4]
-        return tuple(o.reshape(t.shape) for o in out)  # type: ignore[return-value]
+        return out
 
     def positions(self, t: np.ndarray | float) -> np.ndarray:
-        """Reference positions (N, 2) [m] at absolute times ``t`` (N,) [s]."""
-        x, y, _, _, _ = self.sample(np.atleast_1d(np.asarray(t, dtype=float)))
+        """Reference positions (N, 2) [m] at absolute times ``t`` (N,) [s]: :meth:`sample`'s
+        x and y, bit for bit, without computing the rest."""
+        x, y = self._evaluate(np.atleast_1d(np.asarray(t, dtype=float)).ravel(), False)
         p = np.empty((x.size, 2))
-        p[:, 0] = x.ravel()
-        p[:, 1] = y.ravel()
+        p[:, 0] = x
+        p[:, 1] = y
         return p
 
     def state(self, t: float) -> RobotState:

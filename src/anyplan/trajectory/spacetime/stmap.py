@@ -5,7 +5,9 @@ forbidden region of the (s, t) plane is {(s, t): |C(s) - o_i(t)| <= r + r_i(t) +
 covered by a boolean grid of cells [c ds, (c+1) ds] x [t_map + j h, t_map + (j+1) h], a cell
 marked when |C(s_c) - o_i(t_mid)| <= r + r_i,max + margin + ds/2 + v_i h/2 (s_c, t_mid the cell's
 centre, r_i,max the largest radius at the row's ends and middle): conservative, so a motion
-that avoids every marked cell is collision-free with the predicted discs. Predictions are
+that avoids every marked cell is collision-free with the predicted discs (an obstacle whose
+position jumps, an open track at each period, is marked piece by piece between its jumps,
+:func:`_pieces`). Predictions are
 :class:`~anyplan.prediction.PredictedObstacle` or any object with ``name``, ``positions(t)``,
 ``max_speed`` and ``radius`` or a vectorised ``radius_at(t)`` (a radius may grow with time).
 Derivation: ``docs/spacetime.md`` ("Design: path-velocity decomposition ...", step 4).

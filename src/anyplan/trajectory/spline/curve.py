@@ -172,12 +172,14 @@ class SmoothCurve:
                                      np.ascontiguousarray(u, dtype=float),
                                      np.ascontiguousarray(fractions, dtype=float), bool(with_ends))
 
-    def sample_profile(self, profile: ProfileArrays, tau: np.ndarray) -> np.ndarray:
+    def sample_profile(self, profile: ProfileArrays, tau: np.ndarray,
+                       full: bool = True) -> np.ndarray:
         """(x, y, theta, v, omega) (5, N) of driving along the curve with ``profile`` (its arc
-        lengths, speeds and times), at profile times ``tau`` (N,) [s] (clamped)."""
+        lengths, speeds and times), at profile times ``tau`` (N,) [s] (clamped); (x, y) (2, N)
+        alone when not ``full``."""
         a = self.arrays
         return _drive.curve_sample(a.x, a.c, a.s_grid, a.u_grid, a.dus, profile.s, profile.v,
-                                   profile.t, tau)
+                                   profile.t, tau, bool(full))
 
     def profile_speed_bound(self, profile: ProfileArrays, nsub: int = 8) -> float:
         """Bound on |d position / dt| [m/s] when driving with ``profile``, before any inflation:
