@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit
 
 from anyplan.prediction.base import PredictedObstacle
-from anyplan.world.motion import UnicycleMotion
+from anyplan.world.motion import UnicycleMotion, WaypointMotion
 
 #: [m] added to the contact distance: a gap this close to zero counts as contact (rounding).
 CONTACT_EPS = 1e-12
@@ -339,3 +339,36 @@ class StraightDiscs:
         return straight_contacts(ts, xs, ys, float(t0), float(t1), self.x0, self.y0, self.vx,
                                  self.vy, self.t_s, reach0 + self.radius, self.until, self.g_t0,
                                  self.taus, self.g_vals, bool(first_only))
+
+
+@dataclass(frozen=True)
+class LoopingTracks:
+    """The looping tracks (``WaypointMotion`` without growth) of one prediction set as the
+    kernels' arrays, one row per track: their indices in the set (``index``), keyframes
+    (``kf``, padded to the longest with rows at time +inf) and keyframe counts (``lens``),
+    whether each is open (``opened``: it jumps back at each period's start), speed bounds
+    [m/s], radii [m] and horizons (``until``) [s]."""
+
+    index: np.ndarray
+    kf: np.ndarray
+    lens: np.ndarray
+    opened: np.ndarray
+    speed: np.ndarray
+    radius: np.ndarray
+    until: np.ndarray
+
+    @classmethod
+    def of(cls, obstacles: Sequence[PredictedObstacle]) -> LoopingTracks:
+        index = [k for k, o in enumerate(obstacles)
+                 if o.growth is None and isinstance(o.motion, WaypointMotion)]
+        ms: list[WaypointMotion] = [obstacles[k].motion for k in index]  # type: ignore[misc]
+        lens = np.array([len(m.keyframes) for m in ms], dtype=np.int64)
+        kf = np.zeros((len(ms), int(lens.max()) if len(ms) else 2, 3))
+        kf[:, :, 0] = math.inf
+        for j, m in enumerate(ms):
+            kf[j, :lens[j]] = m.keyframes
+        return cls(np.array(index, dtype=np.int64), kf, lens,
+                   np.array([m.is_open for m in ms], dtype=np.bool_),
+                   np.array([m.max_speed for m in ms], dtype=float),
+                   np.array([obstacles[k].radius for k in index], dtype=float),
+                   np.array([obstacles[k].until for k in index], dtype=float))

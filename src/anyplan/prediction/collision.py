@@ -26,7 +26,12 @@ from typing import Any, Protocol
 import numpy as np
 
 from anyplan.geometry.moving import first_contact, first_contact_growing
-from anyplan.prediction._contact_kernels import StraightDiscs, track_contacts, track_start_bounds
+from anyplan.prediction._contact_kernels import (
+    LoopingTracks,
+    StraightDiscs,
+    track_contacts,
+    track_start_bounds,
+)
 from anyplan.prediction.base import PredictedObstacle, RadiusGrowth
 from anyplan.world.motion import TrackMotion, UnicycleMotion, WaypointMotion
 
@@ -193,30 +198,27 @@ def _predict(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], robot_
 def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle],
                       robot_radius: float, t0: float, t1: float, margin: float, tol: float,
                       sample_dt: float | None, first_only: bool) -> list[PredictedCollision]:
-    """The discs on straight lines (the ``twist`` and ``tracked`` predictions) in closed form
-    on the robot's samples (:func:`_straight_hits`), the others by the certified search
-    (:func:`_certified_hits`); merged, earliest first."""
+    """Straight discs and looping tracks in closed form on the robot's samples, the others by
+    the certified search (:func:`_certified_hits`); merged, earliest first."""
     if t1 < t0 or not obstacles:
         return []
     if sample_dt is None:
         return _certified_hits(motion, obstacles, robot_radius, t0, t1, margin, tol, None,
                                first_only)
-    lines = _by_identity(_LINES, obstacles, lambda: StraightDiscs.of(obstacles))
-    stack = _stack(obstacles)
-    if not len(lines.index) and not len(stack.tracks):
+    lines, tracks, rest = _closed(obstacles)
+    if not len(lines.index) and not len(tracks.index):
         return _certified_hits(motion, obstacles, robot_radius, t0, t1, margin, tol, sample_dt,
                                first_only)
-    rest = sorted(set(lines.rest) - set(stack.tracks.tolist()))
     # every obstacle in closed form: the robot is not sampled after the last prediction's end
     stop = max(float(lines.until.max(initial=-math.inf)),
-               float(stack.until[stack.tracks].max(initial=-math.inf))) if not rest else math.inf
+               float(tracks.until.max(initial=-math.inf))) if not rest else math.inf
     sampled = SampledMotion(motion, t0, t1, sample_dt, stop)
     reach0 = robot_radius + margin
     out = []
     if len(lines.index):
         out += _straight_hits(motion, sampled, obstacles, lines, reach0, t0, t1, first_only)
-    if len(stack.tracks):
-        out += _track_hits(motion, sampled, obstacles, stack, reach0, t0, t1, first_only)
+    if len(tracks.index):
+        out += _track_hits(motion, sampled, obstacles, tracks, reach0, t0, t1, first_only)
     if rest:  # each obstacle's contact is its own: the same answer with or without the others
         out += _certified_hits(motion, [obstacles[k] for k in rest], robot_radius, t0, t1,
                                margin, tol, sample_dt, first_only, sampled)
@@ -224,8 +226,18 @@ def _predict_uncached(motion: TimedMotion, obstacles: Sequence[PredictedObstacle
     return out[:1] if first_only else out
 
 
-#: Recent :class:`StraightDiscs` records, by the identity of their prediction sets.
-_LINES: dict[tuple[int, ...], tuple[tuple[object, ...], Any]] = {}
+_Closed = tuple[StraightDiscs, LoopingTracks, tuple[int, ...]]
+_LINES: dict[tuple[int, ...], tuple[tuple[object, ...], Any]] = {}  # recent _closed, by identity
+
+
+def _closed(obstacles: Sequence[PredictedObstacle]) -> _Closed:
+    """The straight discs and the looping tracks of a prediction set, and the indices of the
+    others (memoised by the set's identity: a planner asks one set many times)."""
+    def build() -> _Closed:
+        lines, tracks = StraightDiscs.of(obstacles), LoopingTracks.of(obstacles)
+        return lines, tracks, tuple(sorted(set(lines.rest) - set(tracks.index.tolist())))
+
+    return _by_identity(_LINES, obstacles, build)
 
 
 def _straight_hits(motion: TimedMotion, sampled: SampledMotion,
@@ -241,19 +253,17 @@ def _straight_hits(motion: TimedMotion, sampled: SampledMotion,
 
 
 def _track_hits(motion: TimedMotion, sampled: SampledMotion,
-                obstacles: Sequence[PredictedObstacle], stack: _Stack, reach0: float, t0: float,
+                obstacles: Sequence[PredictedObstacle], tracks: LoopingTracks, reach0: float, t0: float,
                 t1: float, first_only: bool) -> list[PredictedCollision]:
-    """First contacts with the looping tracks of ``stack`` (``WaypointMotion`` without growth),
-    exact on the robot's samples with the contact distance enlarged by their error bound (so
-    never later than the true motion's), jumps of open tracks included, by
-    :func:`track_contacts`."""
-    rows = stack.tracks
+    """First contacts with the looping ``tracks``, exact on the robot's samples with the contact
+    distance enlarged by their error bound (so never later than the true motion's), jumps of
+    open tracks included, by :func:`track_contacts`."""
     times = track_contacts(sampled._t, sampled._x, sampled._y, float(t0),
-                           float(min(t1, sampled.t_end)), stack.kf,
-                           stack.lens, np.arange(len(rows)), stack.speed[rows],
-                           reach0 + sampled.error_bound + stack.radius[rows], stack.until[rows],
+                           float(min(t1, sampled.t_end)), tracks.kf, tracks.lens,
+                           np.arange(len(tracks.index)), tracks.speed,
+                           reach0 + sampled.error_bound + tracks.radius, tracks.until,
                            float(sampled.max_speed), bool(first_only))
-    return _hits(motion, obstacles, rows, times, first_only)
+    return _hits(motion, obstacles, tracks.index, times, first_only)
 
 
 def _hits(motion: TimedMotion, obstacles: Sequence[PredictedObstacle], index: np.ndarray,
@@ -316,7 +326,7 @@ def _certified_hits(motion: TimedMotion, obstacles: Sequence[PredictedObstacle],
         if o.until < t0 or far[k]:
             return None  # predicted only before the interval, or never near the robot
         reach = robot_radius + o.radius + margin + extra
-        jumps = _jump_times(o, grid[0], grid[-1])
+        jumps = [j.time for j in o.motion.jumps(grid[0], grid[-1])]
         if not len(jumps) and len(ic) < len(grid) and np.all(gap_bounds(o, gc, pc) > reach):
             return None
         low = gap_bounds(o, grid, p) <= reach
@@ -351,7 +361,7 @@ def _certified_hits(motion: TimedMotion, obstacles: Sequence[PredictedObstacle],
         reach = robot_radius + o.radius + margin + extra
         t1o = min(t1, o.until)
         tc = None
-        for a, b in _continuous(o, ts, t1o):  # the speed bound holds between jumps only
+        for a, b in o.motion.continuous_pieces(ts, t1o):  # the speed bound holds between jumps
             if o.growth is None:
                 tc = first_contact(motion.positions, o.positions, vr + o.max_speed, reach, a, b,
                                    tol=tol)
@@ -368,27 +378,6 @@ def _certified_hits(motion: TimedMotion, obstacles: Sequence[PredictedObstacle],
         out.append(hit)
         out.sort(key=lambda c: c.t)
     return out
-
-
-def _jump_times(o: PredictedObstacle, t0: float, t1: float) -> np.ndarray:
-    """The times [s] in [t0, t1] at which ``o``'s motion jumps (an open track's periods)."""
-    return np.array([j.time for j in o.motion.jumps(t0, t1) if t0 <= j.time <= t1], dtype=float)
-
-
-#: [s] a piece of :func:`_continuous` starts this long after a jump and the one before ends
-#: this long before it: a jump's time (n times the period) and the wrap of the positions
-#: (``t mod period``) may differ by rounding. The position there is the jump's limit to within
-#: the obstacle's speed times it, far below any search tolerance.
-_BEFORE_JUMP = 1e-9
-
-
-def _continuous(o: PredictedObstacle, t0: float, t1: float) -> list[tuple[float, float]]:
-    """[t0, t1] [s] cut at the jumps of ``o``'s motion into pieces on which it is continuous:
-    each jump starts a piece (a piece may be a single instant)."""
-    js = [float(j) for j in _jump_times(o, t0, t1) if j > t0]
-    starts = [t0, *(min(j + _BEFORE_JUMP, t1) for j in js)]
-    ends = [*(j - _BEFORE_JUMP for j in js), t1]
-    return [(a, max(a, b)) for a, b in zip(starts, ends, strict=True)]
 
 
 def _far_from_tracks(obstacles: Sequence[PredictedObstacle], gc: np.ndarray, pc: np.ndarray,
@@ -446,12 +435,12 @@ def _start_bounds(obstacles: Sequence[PredictedObstacle], far: np.ndarray, grid:
         return out
     half_fine = 0.5 * float(np.diff(grid).max())
     _straight_bounds(obstacles, far, out, gc, pc, half_fine, vr, reach0)
-    stack = _stack(obstacles)
-    rows = np.flatnonzero(~far[stack.tracks])  # rows of the pacing tracks, not far
+    tracks = _closed(obstacles)[1]
+    rows = np.flatnonzero(~far[tracks.index])  # rows of the pacing tracks, not far
     if len(rows):
-        out[stack.tracks[rows]] = track_start_bounds(
-            stack.kf, stack.lens, rows, stack.speed[stack.tracks], stack.radius[stack.tracks],
-            stack.opened, gc, np.ascontiguousarray(pc), float(vr), half_fine, float(reach0))
+        out[tracks.index[rows]] = track_start_bounds(
+            tracks.kf, tracks.lens, rows, tracks.speed, tracks.radius, tracks.opened, gc,
+            np.ascontiguousarray(pc), float(vr), half_fine, float(reach0))
     return out
 
 
@@ -533,11 +522,6 @@ class _Stack:
         t0: (n,) each growth's t0 [s] (nan without growth).
         values: (n, K) each growth's values [m] on ``taus`` (when shared; else K = 0).
         growths: each obstacle's growth (None without), for the interpolation one by one.
-        until: (n,) the predictions' horizons [s].
-        tracks: indices of the looping tracks (``WaypointMotion``) without growth.
-        kf: (len(tracks), K, 3) their keyframes, padded to the longest (rows past a track's
-            end at time +inf); ``lens`` (len(tracks),) their keyframe counts; ``opened``
-            (len(tracks),) True for an open track (it jumps back at each period's start).
     """
 
     boxes: np.ndarray
@@ -551,11 +535,6 @@ class _Stack:
     t0: np.ndarray
     values: np.ndarray
     growths: tuple[RadiusGrowth | None, ...]
-    until: np.ndarray
-    tracks: np.ndarray
-    kf: np.ndarray
-    lens: np.ndarray
-    opened: np.ndarray
 
 
 #: Recent :class:`_Stack` records (``_stack``). A fallback ranking checks some twenty
@@ -590,18 +569,8 @@ def _build_stack(obstacles: Sequence[PredictedObstacle]) -> _Stack:
         for k, g in enumerate(growths):
             if g is not None:
                 values[k] = g.values
-    tracks = np.array([k for k, o in enumerate(obstacles)
-                       if o.growth is None and isinstance(o.motion, WaypointMotion)], dtype=np.int64)
-    keys = [obstacles[k].motion.keyframes for k in tracks]
-    lens = np.array([len(k) for k in keys], dtype=np.int64)
-    kf = np.zeros((len(keys), int(lens.max()) if len(keys) else 2, 3))
-    kf[:, :, 0] = math.inf
-    for j, k in enumerate(keys):
-        kf[j, :lens[j]] = k
     return _Stack(boxes, speed, rate, grown, np.array([o.radius for o in obstacles], dtype=float),
-                  straight, line, taus, t0, values, tuple(growths),  # type: ignore[arg-type]
-                  np.array([o.until for o in obstacles], dtype=float), tracks, kf, lens,
-                  np.array([obstacles[k].motion.is_open for k in tracks], dtype=np.bool_))
+                  straight, line, taus, t0, values, tuple(growths))  # type: ignore[arg-type]
 
 
 def _growth_rows(stack: _Stack, rows: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -23,11 +23,15 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-__all__ = ["Jump", "Motion", "UnicycleMotion", "WaypointMotion", "TrackMotion", "positions_of"]
+__all__ = ["Jump", "Motion", "UnicycleMotion", "WaypointMotion", "TrackMotion", "positions_of",
+           "JUMP_SLACK_S"]
 
 
 #: Tolerance [s] on a jump's time (:meth:`Motion.jumps`).
 _JUMP_EPS = 1e-9
+#: [s] how far from a jump's reported time the positions may still be on its other side
+#: (rounding): pieces between jumps keep this far from them (:meth:`Motion.continuous_pieces`).
+JUMP_SLACK_S = 1e-9
 
 
 class Jump(NamedTuple):
@@ -69,6 +73,17 @@ class Motion:
         end moved 1 ns later, so that a jump at t1 is reported once, not again from t0 = t1),
         in time order; none for a continuous motion."""
         return ()
+
+    def continuous_pieces(self, t0: float, t1: float) -> list[tuple[float, float]]:
+        """[t0, t1] [s] cut at the jumps into pieces on which the position is continuous (so a
+        bound on the speed holds on each): each jump starts a piece (which may be a single
+        instant). A jump's time (n times a period) and the wrap of the positions (t mod the
+        period) may differ by rounding, so a piece starts :data:`JUMP_SLACK_S` after its jump
+        and the one before ends as long before it."""
+        js = [j.time for j in self.jumps(t0, t1) if t0 < j.time <= t1]
+        starts = [t0, *(min(j + JUMP_SLACK_S, t1) for j in js)]
+        ends = [*(j - JUMP_SLACK_S for j in js), t1]
+        return [(a, max(a, b)) for a, b in zip(starts, ends, strict=True)]
 
 
 _EPS = float(np.finfo(float).eps)

@@ -22,6 +22,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from anyplan.world.motion import JUMP_SLACK_S
+
 __all__ = ["STMap", "RowCache", "build_stmap", "radii_at"]
 
 _CHUNK = 16  # path cells per bounding circle of the coarse test
@@ -286,11 +288,6 @@ def _jumps(o: Any, t0: float, t1: float) -> list[float]:
     return [] if fn is None else [j.time for j in fn(t0, t1) if t0 < j.time <= t1]
 
 
-#: [s] how far from a reported jump time a motion's positions may still be on its other side
-#: (the jump time n p and the wrap of ``t mod p`` differ by rounding): the pieces overlap by it.
-_JUMP_SLACK = 1e-9
-
-
 def _pieces(o: Any, t_map: float, h: float, nfill: int, reach: np.ndarray, speed: float
             ) -> tuple[np.ndarray, np.ndarray]:
     """An obstacle whose position jumps within the rows as one entry per piece between its
@@ -304,13 +301,13 @@ def _pieces(o: Any, t_map: float, h: float, nfill: int, reach: np.ndarray, speed
     js = _jumps(o, t_map, t_end)
     row0 = t_map + h * np.arange(nfill)
     t_mid = row0 + 0.5 * h
-    grow = 0.5 * speed * h + speed * 4.0 * _JUMP_SLACK + 1e-9
+    grow = 0.5 * speed * h + speed * 4.0 * JUMP_SLACK_S + 1e-9
     qs, rs = [], []
     for a, b in zip([t_map, *js], [*js, t_end], strict=True):
-        lo = a + _JUMP_SLACK if a in js else a
-        hi = max(lo, b - _JUMP_SLACK) if b in js else max(lo, b)
+        lo = a + JUMP_SLACK_S if a in js else a
+        hi = max(lo, b - JUMP_SLACK_S) if b in js else max(lo, b)
         qs.append(np.asarray(o.positions(np.clip(t_mid, lo, hi)), dtype=float).reshape(-1, 2))
-        inside = (row0 + h >= a - _JUMP_SLACK) & (row0 <= b + _JUMP_SLACK)
+        inside = (row0 + h >= a - JUMP_SLACK_S) & (row0 <= b + JUMP_SLACK_S)
         rs.append(np.where(inside, reach + grow, -1.0))
     return np.stack(qs), np.stack(rs)
 
