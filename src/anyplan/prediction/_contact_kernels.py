@@ -1,16 +1,17 @@
-"""Compiled first contacts of a sampled robot motion with discs on straight lines.
+"""Compiled first contacts of a sampled robot motion with discs on straight lines and on
+looping tracks.
 
-The robot's motion is given by samples (``SampledMotion``: linear between them), each obstacle
-moves on a straight line at constant velocity from its start time (at rest before it), and its
-radius grows piecewise linearly with the horizon (``RadiusGrowth`` on knots shared by all).
-Between consecutive breakpoints (the samples, the start time, the growth's knots) the relative
-position and the contact distance are both affine in time, so the squared gap
-``|d(s)|^2 - c(s)^2`` is a quadratic and its first root is closed form: the first contact is
-exact up to rounding, with no time tolerance. :class:`StraightDiscs` holds one prediction
-set's straight discs as the kernel's arrays (``anyplan.prediction.collision`` uses it for the
-twist and tracked predictions and straight movers). :func:`track_start_bounds` is the broad
-phase of the certified search for looping tracks (``WaypointMotion``): where each may first
-come near the robot.
+The robot's motion is given by samples (``SampledMotion``: linear between them). A straight
+disc moves at constant velocity from its start time (at rest before it) and its radius grows
+piecewise linearly with the horizon (``RadiusGrowth`` on knots shared by all); a looping track
+(``WaypointMotion``) is piecewise linear and repeats every period, an open one jumping back to
+its first keyframe. Between consecutive breakpoints (samples, start time, growth knots,
+keyframes, periods' starts) the relative position and the contact distance are both affine in
+time, so the squared gap ``|d(s)|^2 - c(s)^2`` is a quadratic and its first root is closed
+form: the first contact is exact up to rounding, with no time tolerance.
+:class:`StraightDiscs` and :class:`LoopingTracks` hold one prediction set's discs and tracks as
+the kernels' arrays (``anyplan.prediction.collision`` uses them); :func:`track_start_bounds` is
+the certified search's broad phase for tracks (where each may first come near the robot).
 """
 
 from __future__ import annotations
