@@ -35,6 +35,9 @@ def _same_motion(a, b) -> None:
     t = np.linspace(a.t_start - 0.5, a.t_end + 0.5, 1501)
     for u, v in zip(a.sample(t), b.sample(t), strict=True):
         assert np.array_equal(u, v)
+    # positions alone (each segment's xy) are the samples' x and y, bit for bit
+    x, y = a.sample(t)[:2]
+    assert a.positions(t).tobytes() == np.column_stack([x, y]).tobytes()
 
 
 @pytest.mark.parametrize("state", STATES)

@@ -211,7 +211,8 @@ def test_retimed_motion_passes_behind_and_is_certified_free():
     t5 = t[np.argmax(p[:, 0] >= 5.0)]
     assert ob.positions(np.array([t5]))[0, 1] > 2.0 + 0.6
     # Limits every 1 ms.
-    _, _, _, v, w = new.sample(t)
+    x, y, _, v, w = new.sample(t)
+    assert p.tobytes() == np.column_stack([x, y]).tobytes()  # positions alone: the same x, y
     assert np.all(v <= SPEC.v_max + 1e-9) and np.all(v >= -1e-9)
     assert np.all(np.abs(np.diff(v)) <= SPEC.a_max * 1e-3 * (1 + 1e-6) + 1e-12)
     assert np.all(np.abs(w) <= SPEC.omega_max + 1e-9)

@@ -129,3 +129,7 @@ class SwerveSegment(_RampSegment):
         tau = np.clip(t - self.t0, 0.0, self.t1 - self.t0)
         _, _, th, v, w = self._twist(tau)
         return (np.interp(tau, self._tau, self._x), np.interp(tau, self._tau, self._y), th, v, w)
+
+    def xy(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        tau = np.clip(np.asarray(t, dtype=float) - self.t0, 0.0, self.t1 - self.t0)
+        return np.interp(tau, self._tau, self._x), np.interp(tau, self._tau, self._y)

@@ -48,6 +48,10 @@ class HoldSegment(Segment):
         z = np.zeros(t.shape)
         return np.full(t.shape, self.x), np.full(t.shape, self.y), np.full(t.shape, self.theta), z, z
 
+    def xy(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        shape = np.shape(t)
+        return np.full(shape, self.x), np.full(shape, self.y)
+
     def path_points(self, step: float) -> np.ndarray:
         return np.array([[self.x, self.y]])
 

@@ -149,5 +149,9 @@ class TurnSegment(Segment):
         th, w = self.rotation.at_time(t - self.t0)
         return (np.full(t.shape, self.x), np.full(t.shape, self.y), th, np.zeros(t.shape), w)
 
+    def xy(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        shape = np.shape(t)
+        return np.full(shape, self.x), np.full(shape, self.y)
+
     def path_points(self, step: float) -> np.ndarray:
         return np.array([[self.x, self.y]])

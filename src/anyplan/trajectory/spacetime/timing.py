@@ -65,6 +65,11 @@ class TimedCurveSegment(Segment):
         out = (p[:, 0], p[:, 1], th, v, k * v)
         return tuple(np.asarray(o, dtype=float).reshape(t.shape) for o in out)
 
+    def xy(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        s, _, _ = self.plan.at_time(np.asarray(t, dtype=float).ravel())
+        p = self.curve.position(self.curve.u_of_s(np.clip(s, 0.0, self.curve.length)))
+        return np.asarray(p[:, 0], dtype=float), np.asarray(p[:, 1], dtype=float)
+
     def path_points(self, step: float) -> np.ndarray:
         return self.curve.samples(step)
 
