@@ -68,6 +68,9 @@ class Motion:
         """Pose and twist at time ``t`` [s]: (x [m], y [m], heading [rad], v [m/s], omega [rad/s])."""
         raise NotImplementedError
 
+    #: False when the position never jumps (:meth:`jumps` is then always empty).
+    may_jump: bool = False
+
     def jumps(self, t0: float, t1: float) -> tuple[Jump, ...]:
         """The jumps (teleports, not motions) of the position at times in (t0, t1] [s] (each
         end moved 1 ns later, so that a jump at t1 is reported once, not again from t0 = t1),
@@ -80,6 +83,8 @@ class Motion:
         instant). A jump's time (n times a period) and the wrap of the positions (t mod the
         period) may differ by rounding, so a piece starts :data:`JUMP_SLACK_S` after its jump
         and the one before ends as long before it."""
+        if not self.may_jump:
+            return [(t0, max(t0, t1))]
         js = [j.time for j in self.jumps(t0, t1) if t0 < j.time <= t1]
         starts = [t0, *(min(j + JUMP_SLACK_S, t1) for j in js)]
         ends = [*(j - JUMP_SLACK_S for j in js), t1]
@@ -270,6 +275,7 @@ class WaypointMotion(Motion):
         object.__setattr__(self, "keyframes", k)
         object.__setattr__(self, "_vmax", _track_speed(k))  # asked for by every prediction check
         object.__setattr__(self, "_kf", _columns(k))
+        object.__setattr__(self, "_open", bool(k[-1, 1] != k[0, 1] or k[-1, 2] != k[0, 2]))
 
     @property
     def period(self) -> float:
@@ -283,8 +289,11 @@ class WaypointMotion(Motion):
     @property
     def is_open(self) -> bool:
         """True if the track does not end where it starts: it jumps back at every period."""
-        k = self.keyframes
-        return bool(k[-1, 1] != k[0, 1] or k[-1, 2] != k[0, 2])
+        return self._open  # type: ignore[attr-defined]  # set in __post_init__
+
+    @property
+    def may_jump(self) -> bool:  # type: ignore[override]
+        return self.is_open
 
     def jumps(self, t0: float, t1: float) -> tuple[Jump, ...]:
         """An open track jumps from its last keyframe back to its first at every multiple of

@@ -284,8 +284,9 @@ class STMap:
 def _jumps(o: Any, t0: float, t1: float) -> list[float]:
     """Times [s] in (t0, t1] at which the position of ``o`` jumps (an open track's periods)."""
     m = getattr(o, "motion", None)
-    fn = getattr(m, "jumps", None)
-    return [] if fn is None else [j.time for j in fn(t0, t1) if t0 < j.time <= t1]
+    if m is None or not getattr(m, "may_jump", False):
+        return []
+    return [j.time for j in m.jumps(t0, t1) if t0 < j.time <= t1]
 
 
 def _pieces(o: Any, t_map: float, h: float, nfill: int, reach: np.ndarray, speed: float
