@@ -77,15 +77,22 @@ class Motion:
         in time order; none for a continuous motion."""
         return ()
 
+    def jump_times(self, t0: float, t1: float) -> list[float]:
+        """The times [s] of the jumps in (t0, t1] exactly (:meth:`jumps` reports up to 1 ns past
+        t1); empty at once for a motion that never jumps."""
+        if not self.may_jump:
+            return []
+        return [j.time for j in self.jumps(t0, t1) if t0 < j.time <= t1]
+
     def continuous_pieces(self, t0: float, t1: float) -> list[tuple[float, float]]:
         """[t0, t1] [s] cut at the jumps into pieces on which the position is continuous (so a
         bound on the speed holds on each): each jump starts a piece (which may be a single
         instant). A jump's time (n times a period) and the wrap of the positions (t mod the
         period) may differ by rounding, so a piece starts :data:`JUMP_SLACK_S` after its jump
         and the one before ends as long before it."""
-        if not self.may_jump:
+        js = self.jump_times(t0, t1)
+        if not js:
             return [(t0, max(t0, t1))]
-        js = [j.time for j in self.jumps(t0, t1) if t0 < j.time <= t1]
         starts = [t0, *(min(j + JUMP_SLACK_S, t1) for j in js)]
         ends = [*(j - JUMP_SLACK_S for j in js), t1]
         return [(a, max(a, b)) for a, b in zip(starts, ends, strict=True)]

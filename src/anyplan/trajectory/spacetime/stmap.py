@@ -282,24 +282,22 @@ class STMap:
 
 
 def _jumps(o: Any, t0: float, t1: float) -> list[float]:
-    """Times [s] in (t0, t1] at which the position of ``o`` jumps (an open track's periods)."""
+    """Times [s] in (t0, t1] at which the position of ``o`` jumps (an open track's periods;
+    none for an obstacle without a motion that says so)."""
     m = getattr(o, "motion", None)
-    if m is None or not getattr(m, "may_jump", False):
-        return []
-    return [j.time for j in m.jumps(t0, t1) if t0 < j.time <= t1]
+    return m.jump_times(t0, t1) if m is not None and getattr(m, "may_jump", False) else []
 
 
-def _pieces(o: Any, t_map: float, h: float, nfill: int, reach: np.ndarray, speed: float
-            ) -> tuple[np.ndarray, np.ndarray]:
-    """An obstacle whose position jumps within the rows as one entry per piece between its
-    jumps: centres (pieces, rows, 2) [m] at each row's middle clamped into the piece (just
-    after the jump it starts with, just before the one it ends with), contact distances
-    (pieces, rows) [m] ``reach`` grown by v h / 2 (a time of the piece in the row lies within
-    h of the clamped one, up to the slack, and the motion is continuous on the piece), none
-    (-1) in rows outside the piece. Consecutive rows' clamped times are at most 1.5 h apart
+def _pieces(o: Any, js: list[float], t_map: float, h: float, nfill: int, reach: np.ndarray,
+            speed: float) -> tuple[np.ndarray, np.ndarray]:
+    """An obstacle whose position jumps within the rows (at the times ``js`` [s]) as one entry
+    per piece between its jumps: centres (pieces, rows, 2) [m] at each row's middle clamped
+    into the piece (just after the jump it starts with, just before the one it ends with),
+    contact distances (pieces, rows) [m] ``reach`` grown by v h / 2 (a time of the piece in
+    the row lies within h of the clamped one, up to the slack, and the motion is continuous on
+    the piece), none (-1) in rows outside the piece. Consecutive rows' clamped times are at most 1.5 h apart
     (the spread :func:`_fill` is given)."""
     t_end = t_map + nfill * h
-    js = _jumps(o, t_map, t_end)
     row0 = t_map + h * np.arange(nfill)
     t_mid = row0 + 0.5 * h
     grow = 0.5 * speed * h + speed * 4.0 * JUMP_SLACK_S + 1e-9
@@ -375,9 +373,11 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     spread = speed * h
     owner = np.arange(len(obstacles))
     t_end = t_map + nfill * h
-    jumpy = [k for k, o in enumerate(obstacles) if _jumps(o, t_map, t_end)]
+    jumps = {k: js for k, o in enumerate(obstacles) if (js := _jumps(o, t_map, t_end))}
+    jumpy = list(jumps)
     if jumpy:  # each such obstacle as its pieces between jumps (_pieces)
-        parts = [_pieces(obstacles[k], t_map, h, nfill, reach[k], float(speed[k])) for k in jumpy]
+        parts = [_pieces(obstacles[k], jumps[k], t_map, h, nfill, reach[k], float(speed[k]))
+                 for k in jumpy]
         keep = np.setdiff1d(owner, jumpy)
         owner = np.concatenate([keep, *(np.full(len(pc[0]), k) for k, pc in zip(jumpy, parts,
                                                                                strict=True))])
