@@ -213,12 +213,11 @@ def _track_at(kf: np.ndarray, k: int, nk: int, t: float) -> tuple[int, float]:
 
 @njit(cache=True)
 def track_contacts(ts: np.ndarray, xs: np.ndarray, ys: np.ndarray, t0: float, t1: float,
-                   kf: np.ndarray, lens: np.ndarray, rows: np.ndarray, speed: np.ndarray,
-                   reach: np.ndarray, until: np.ndarray, vr: float,
-                   first_only: bool) -> np.ndarray:
+                   kf: np.ndarray, lens: np.ndarray, speed: np.ndarray, reach: np.ndarray,
+                   until: np.ndarray, vr: float, first_only: bool) -> np.ndarray:
     """First contact time [s] in [t0, t1] of the robot (samples ``ts``, ``xs``, ``ys``, linear
     between them, speed at most ``vr`` [m/s], [t0, t1] within them) with each looping track
-    ``k = rows[j]`` (keyframes ``kf[k, :lens[k]]``, rows (t, x, y), repeated every period; an
+    ``k`` (keyframes ``kf[k, :lens[k]]``, rows (t, x, y), repeated every period; an
     open track jumps back to its first keyframe at each period's start; speed at most
     ``speed[k]`` [m/s]), contact distance ``reach[k]`` [m], checked up to ``until[k]`` [s];
     inf where there is none.
@@ -228,10 +227,9 @@ def track_contacts(ts: np.ndarray, xs: np.ndarray, ys: np.ndarray, t0: float, t1
     the gap g [m] is wide the scan moves on by g / (vr + speed) at once (the gap cannot close
     faster), never past a period's start. ``first_only``: as in :func:`straight_contacts`."""
     n = ts.shape[0]
-    out = np.full(rows.shape[0], np.inf)
+    out = np.full(kf.shape[0], np.inf)
     best = np.inf
-    for j in range(rows.shape[0]):
-        k = rows[j]
+    for k in range(kf.shape[0]):
         nk = lens[k]
         period = kf[k, nk - 1, 0]
         t_end = min(t1, until[k])
@@ -271,7 +269,7 @@ def track_contacts(ts: np.ndarray, xs: np.ndarray, ys: np.ndarray, t0: float, t1
                 elif gap <= 0.0:
                     r = 0.0
                 if r >= 0.0:
-                    out[j] = min(p + r, t_end)
+                    out[k] = min(p + r, t_end)
                     break
                 if q >= t_end:
                     break
@@ -283,8 +281,8 @@ def track_contacts(ts: np.ndarray, xs: np.ndarray, ys: np.ndarray, t0: float, t1
                 if s == nk - 1:  # the period's end: the next period's first segment
                     s = 0
                     m += 1.0
-        if out[j] < best:
-            best = out[j]
+        if out[k] < best:
+            best = out[k]
     return out
 
 

@@ -259,8 +259,7 @@ def _track_hits(motion: TimedMotion, sampled: SampledMotion,
     distance enlarged by their error bound (so never later than the true motion's), jumps of
     open tracks included, by :func:`track_contacts`."""
     times = track_contacts(sampled._t, sampled._x, sampled._y, float(t0),
-                           float(min(t1, sampled.t_end)), tracks.kf, tracks.lens,
-                           np.arange(len(tracks.index)), tracks.speed,
+                           float(min(t1, sampled.t_end)), tracks.kf, tracks.lens, tracks.speed,
                            reach0 + sampled.error_bound + tracks.radius, tracks.until,
                            float(sampled.max_speed), bool(first_only))
     return _hits(motion, obstacles, tracks.index, times, first_only)
