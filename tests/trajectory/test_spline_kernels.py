@@ -144,8 +144,8 @@ def test_branch_and_bound_on_a_long_curve_out_of_its_arena_finds_the_same_worst_
 @pytest.mark.parametrize("seed", range(16))
 def test_branch_and_bound_on_maps_finds_the_same_worst_pieces(seed):
     # The same on a map: curves through walls (buried pieces: no clearance queries below them),
-    # past them (capped queries, deferred pieces) and out of the arena; and the memo answers a
-    # repeated question with the same answer.
+    # past them (capped queries, deferred pieces) and out of the arena; a repeated question
+    # gets the same answer.
     from anyplan.geometry.cells import cell_boxes, merge_cells
 
     rng = np.random.default_rng(seed)

@@ -12,8 +12,6 @@ See ``docs/motion.md`` ("Smoothing and collision certification").
 
 from __future__ import annotations
 
-import hashlib
-
 import numpy as np
 
 from anyplan.geometry.collision import COLLISION_EPS, ObstacleSet
@@ -34,38 +32,15 @@ def failing_pieces(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
     return curve.point_index(fail_u), fail_u, fail_c, margin
 
 
-#: Recent answers of :func:`worst_failures`, newest last: (key, answer). A planner often
-#: certifies the same curve among the same obstacles several times (e.g. one path timed with
-#: several departure delays); the key is the content of both, so a hit is the same computation.
-_MEMO: list[tuple[tuple[bytes, bytes, float, int], tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                          float]]] = []
-_MEMO_SIZE = 32
-
-
-def _curve_digest(curve: SmoothCurve) -> bytes:
-    cv = curve.arrays
-    h = hashlib.blake2b(digest_size=16)
-    for a in (cv.x, cv.c, cv.u_grid, cv.point_u):
-        h.update(np.ascontiguousarray(a).tobytes())
-        h.update(b"|")
-    return h.digest()
-
-
 def worst_failures(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
                     max_depth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """What the repair uses of :func:`failing_pieces`: per interpolation interval with failing pieces,
     its first failing piece of least certified clearance (k, midpoint u, clearance), found by
     branch and bound (see ``_clearance.certify_worst``); the margin is valid when nothing fails.
-    A repeated question (same curve, obstacles, radius and depth) is answered from a memo."""
-    key = (_curve_digest(curve), obstacles.fingerprint, float(radius), int(max_depth))
-    for k, ans in _MEMO:
-        if k == key:
-            return ans[0].copy(), ans[1].copy(), ans[2].copy(), ans[3]
-    ks, fu, fc, margin = _clearance.certify_worst(curve.arrays, radius - COLLISION_EPS,
-                                                  float(radius), int(max_depth), obstacles.arrays)
-    _MEMO.append((key, (ks.copy(), fu.copy(), fc.copy(), margin)))
-    del _MEMO[:-_MEMO_SIZE]
-    return ks, fu, fc, margin
+    Not memoised: :func:`~anyplan.trajectory.spline.smooth.smooth_path` memoises whole
+    smoothings, and a curve certified twice outside that memo is rare (1-2 % of the calls)."""
+    return _clearance.certify_worst(curve.arrays, radius - COLLISION_EPS, float(radius),
+                                    int(max_depth), obstacles.arrays)
 
 
 def curve_clearance_ok(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
