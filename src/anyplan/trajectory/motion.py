@@ -65,14 +65,33 @@ def _table_free(seg: BrakeSegment | SwerveSegment, obstacles: ObstacleSet, radiu
     return bool(np.all(obstacles.segments_clearance(pts[:-1], pts[1:]) >= radius + 1e-6 - COLLISION_EPS))
 
 
+#: Recent braking segments, newest last: (key, segment, {(obstacles' fingerprint, radius):
+#: free}). A fallback ranking brakes from one state for each of its candidates (the guard's,
+#: 8 evasions); the key is every input, so a hit is the same segment (segments are not changed
+#: once built, and trajectories share them).
+_BRAKES: list[tuple[bytes, BrakeSegment, dict[tuple[bytes, float], bool]]] = []
+_BRAKES_SIZE = 8
+
+
 def _brake(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: float,
            t0: float) -> tuple[BrakeSegment | None, bool]:
     """The braking segment (None at rest) and whether it is certified free."""
     if abs(state.v) <= _EPS_V:
         return None, True
-    seg = BrakeSegment(state.x, state.y, state.theta, state.v, state.omega, spec.a_max,
-                       spec.alpha_max, t0)
-    return seg, _table_free(seg, obstacles, radius)
+    # the inputs' bits (0.0 and -0.0 are equal floats, not the same input)
+    key = np.array([state.x, state.y, state.theta, state.v, state.omega, spec.a_max, spec.alpha_max,
+                    t0], dtype=float).tobytes()
+    entry = next((e for e in _BRAKES if e[0] == key), None)
+    if entry is None:
+        entry = (key, BrakeSegment(state.x, state.y, state.theta, state.v, state.omega, spec.a_max,
+                                   spec.alpha_max, t0), {})
+        _BRAKES.append(entry)
+        del _BRAKES[:-_BRAKES_SIZE]
+    _, seg, free = entry
+    fkey = (obstacles.fingerprint, float(radius))
+    if fkey not in free:
+        free[fkey] = _table_free(seg, obstacles, radius)
+    return seg, free[fkey]
 
 
 def brake_to_rest(state: RobotState, spec: RobotSpec, obstacles: ObstacleSet, radius: float,
