@@ -293,3 +293,31 @@ def test_turn_candidate_pruned_by_its_bound_changes_no_motion(monkeypatch):
         if "pruned" in got.info:
             assert got.info["pruned"]["turn+smooth"] > got.duration
     assert pruned > 0 and won > 0
+
+
+def test_braking_memo_answers_as_a_fresh_braking():
+    # brake_to_rest reuses a braking segment built from the same inputs (bit for bit) and its
+    # certification per obstacle set and radius: the same segment and answer as a fresh one,
+    # never another obstacle set's or radius's answer, and -0.0 is not taken for 0.0.
+    from anyplan.trajectory import motion as mo
+    from anyplan.trajectory.trajectory import BrakeSegment
+
+    spec = load_scenario("paper-1").robot
+    free = ObstacleSet([Circle((3.0, 0.0), 0.2)])
+    wall = ObstacleSet([Circle((1.2, 0.0), 0.2)])  # the braking path ends 0.25 m short of it
+    t = np.linspace(0.5, 2.0, 31)
+    built = []
+    for theta in (0.0, -0.0):
+        st = RobotState(0.5, 0.0, theta, 0.5, 0.0)
+        fresh = BrakeSegment(0.5, 0.0, theta, 0.5, 0.0, spec.a_max, spec.alpha_max, 0.5)
+        answers = []
+        for obst, radius in ((free, 0.3), (wall, 0.3), (free, 0.3), (wall, 0.1)):
+            segs, t_rest, rest, ok = mo.brake_to_rest(st, spec, obst, radius, 0.5)
+            assert all(np.array_equal(a, b) for a, b in zip(segs[0].sample(t), fresh.sample(t),
+                                                           strict=True))
+            assert t_rest == fresh.t1 and rest.v == 0.0
+            answers.append(ok)
+        assert answers == [True, False, True, True]
+        built.append(segs[0])
+        assert mo.brake_to_rest(st, spec, free, 0.3, 0.5)[0][0] is segs[0]  # from the memo
+    assert built[0] is not built[1]
