@@ -71,3 +71,32 @@ def test_moving_robot_against_dense_sampling():
         near |= ex & (dd < 0.2)
     assert m["min_distance_to_moving_m"] == pytest.approx(best, abs=1e-4)
     assert m["discomfort_time_s"] == pytest.approx(near.mean() * 5.0, abs=2e-4)
+
+
+@pytest.mark.parametrize("period", [7.0, 6.97])  # a jump at a step's end, one inside a step
+def test_the_jump_of_an_open_track_is_not_a_motion(period):
+    # J runs (4, 1) -> (16, 1) in 6 s, up to (16, 5), then jumps back to (4, 1): the jump's
+    # chord passes through (10, 3), where the robot is then; its real motion never comes near
+    sc = scenario_from_dict(small_scenario_dict(
+        arena={"width": 20.0, "height": 6.0}, static_obstacles=[], dynamic_obstacles=[
+            {"name": "J", "type": "waypoints", "radius": 0.3,
+             "keyframes": [[0.0, 4.0, 1.0], [6.0, 16.0, 1.0], [period, 16.0, 5.0]]}]))
+    m = sc.moving_obstacles[0].motion
+    assert m.may_jump and m.jump_times(0.0, 8.0) == [period]
+    # the robot dips towards y = 1 (J passes within the discomfort distance at t = 3), then
+    # stands at (10, 3) while J jumps
+    ts = 0.05 * np.arange(161)
+    tr = _traj(np.column_stack([np.full(161, 10.0),
+                                3.0 - 1.3 * np.sin(np.pi * np.minimum(ts, 6.0) / 6.0)]))
+    got = moving_obstacle_metrics(sc, tr)
+    # truth: the robot on its chords, J densely sampled on each piece between its jumps
+    t = np.concatenate([np.linspace(a, b, 400001) for a, b in m.continuous_pieces(0.0, 8.0)])
+    x, y = np.interp(t, tr[:, 0], tr[:, 1]), np.interp(t, tr[:, 0], tr[:, 2])
+    q = m.positions(t)
+    dd = np.hypot(x - q[:, 0], y - q[:, 1]) - 0.6
+    assert got["min_distance_to_moving_m"] == pytest.approx(dd.min(), abs=1e-4)
+    assert dd.min() > 0.0  # (the chord across the jump would give an overlap)
+    near = dd < 0.2
+    dt = np.diff(t)
+    assert got["discomfort_time_s"] == pytest.approx(float(np.sum(dt[near[:-1]])), abs=2e-4)
+    assert got["discomfort_time_s"] > 0.3  # J's real pass below the robot

@@ -23,9 +23,10 @@ import numpy as np
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.moving import closest_approach_straight, first_contact_straight
 from anyplan.geometry.shapes import Circle, Polygon
+from anyplan.world.motion import Jump
 
 __all__ = ["ROBOT_CAUSED_SPEED", "approach_speed", "robot_caused", "nearest_obstacle_point",
-           "static_contact", "disc_contact"]
+           "static_contact", "disc_contact", "step_pieces"]
 
 #: Speed [m/s] towards the obstacle above which a contact counts as robot-caused.
 ROBOT_CAUSED_SPEED = 0.05
@@ -140,3 +141,31 @@ def disc_contact(p: np.ndarray, u: np.ndarray, q: np.ndarray, w: np.ndarray, rea
     if tc is not None:
         return float(tc)
     return closest_approach_straight(p, u, q, w, t0, t1)[0]
+
+
+def step_pieces(jumps: tuple[Jump, ...], p_old: np.ndarray, p_new: np.ndarray, j: int,
+                t0: float, dt: float, s0: float, s1: float
+                ) -> list[tuple[np.ndarray, np.ndarray, float, float]]:
+    """The straight pieces of a moving obstacle's motion over one step, as (position at s = 0
+    [m], velocity [m/s], s_start, s_end) with s the time [s] since the step's start: one chord
+    from ``p_old`` to ``p_new[j]``, or, across a jump (an open DynaBARN track restarting), a
+    chord to the position before it and one from the position after it, so that the teleport
+    is not tested as a motion. ``p_new[j]`` is set to the position after a jump at the step's
+    end (the motion's own position there may round to either side)."""
+    if not jumps:
+        return [(p_old, (p_new[j] - p_old) / dt, s0, s1)]
+    if jumps[-1].time >= t0 + dt - 1e-9:
+        p_new[j] = jumps[-1].after
+    pieces = []
+    start_s, start_p = 0.0, p_old
+    for jump in (*jumps, None):
+        end_s = dt if jump is None else min(max(jump.time - t0, start_s), dt)
+        end_p = p_new[j] if jump is None else jump.before
+        a, b = max(start_s, s0), min(end_s, s1)
+        if b >= a:
+            span = end_s - start_s
+            w = (end_p - start_p) / span if span > 1e-12 else np.zeros(2)
+            pieces.append((start_p - w * start_s, w, a, b))
+        if jump is not None:
+            start_s, start_p = end_s, jump.after
+    return pieces

@@ -34,6 +34,7 @@ from anyplan.simulation.contact import (
     nearest_obstacle_point,
     robot_caused,
     static_contact,
+    step_pieces,
 )
 from anyplan.simulation.feasibility import goal_unreachable
 from anyplan.simulation.localization import LocalizationError
@@ -47,7 +48,6 @@ from anyplan.simulation.perception import (
 )
 from anyplan.simulation.result import WALL_CLOCK_FIELDS, RunResult, RunStatus, without_wall_clock
 from anyplan.world.limits import MAX_SIM_STEPS, MAX_TIME_LIMIT_S, MIN_DT_S
-from anyplan.world.motion import Jump
 from anyplan.world.robot import Command, RobotState, step
 from anyplan.world.scenario import Scenario
 
@@ -292,8 +292,8 @@ class Simulation:
                 s0, s1 = max(t0, lo) - t0, min(t_new, hi) - t0
                 if s1 < s0:
                     continue
-                for q0, w, ps0, ps1 in _step_pieces(o.motion.jumps(t0, t_new), p_obs[j], p_new,
-                                                    j, t0, dt, s0, s1):
+                for q0, w, ps0, ps1 in step_pieces(o.motion.jumps(t0, t_new), p_obs[j], p_new,
+                                                   j, t0, dt, s0, s1):
                     _, d = closest_approach_straight(a, u, q0, w, ps0, ps1)
                     c = d - r - radii[j]
                     if c < step_clear:
@@ -390,31 +390,3 @@ def simulate(scenario: Scenario, agent: Agent, seed: int = 0,
         res.extra["perception"]["tracker"] = agent.settings()
     res.wall_clock_fields += [f"extra.{k}" for k in wall_clock_extra if k in res.extra]
     return res
-
-
-def _step_pieces(jumps: tuple[Jump, ...], p_old: np.ndarray, p_new: np.ndarray, j: int,
-                 t0: float, dt: float, s0: float, s1: float
-                 ) -> list[tuple[np.ndarray, np.ndarray, float, float]]:
-    """The straight pieces of a moving obstacle's motion over one step, as (position at s = 0
-    [m], velocity [m/s], s_start, s_end) with s the time [s] since the step's start: one chord
-    from ``p_old`` to ``p_new[j]``, or, across a jump (an open DynaBARN track restarting), a
-    chord to the position before it and one from the position after it, so that the teleport
-    is not tested as a motion. ``p_new[j]`` is set to the position after a jump at the step's
-    end (the motion's own position there may round to either side)."""
-    if not jumps:
-        return [(p_old, (p_new[j] - p_old) / dt, s0, s1)]
-    if jumps[-1].time >= t0 + dt - 1e-9:
-        p_new[j] = jumps[-1].after
-    pieces = []
-    start_s, start_p = 0.0, p_old
-    for jump in (*jumps, None):
-        end_s = dt if jump is None else min(max(jump.time - t0, start_s), dt)
-        end_p = p_new[j] if jump is None else jump.before
-        a, b = max(start_s, s0), min(end_s, s1)
-        if b >= a:
-            span = end_s - start_s
-            w = (end_p - start_p) / span if span > 1e-12 else np.zeros(2)
-            pieces.append((start_p - w * start_s, w, a, b))
-        if jump is not None:
-            start_s, start_p = end_s, jump.after
-    return pieces
