@@ -419,3 +419,65 @@ def test_threat_found_for_all_obstacles_at_once_is_the_one_found_one_at_a_time(s
     got = _threat(preds, ts, pr, p_rest)
     assert (got is None) == (want is None)
     assert got is None or got.tobytes() == want.tobytes()
+
+
+def test_clearance_is_searched_between_the_jumps_of_an_open_track():
+    # The robot holds at (0, 0) over [38, 43] s. A stands 0.7 m away (clearance 0.1 m). B, an
+    # open track at 2 m/s, jumps back to its first keyframe 0.522 m from the robot (overlap) at
+    # t = 39.901 s, just after a point of the 0.1 s pre-filter grid, and leaves at once: no speed
+    # bound holds across the jump, so B must be searched piece by piece, not dropped behind A.
+    from anyplan.trajectory.reference import HoldSegment
+    from anyplan.world.motion import WaypointMotion
+
+    spec = RobotSpec((0.0, 0.0, 0.0), (30.0, 0.0), radius=0.3, v_max=2.0, omega_max=2.0,
+                     a_max=2.0, alpha_max=4.0)
+    guard = SafetyGuard(spec, ObstacleSet([]))
+    a = PredictedObstacle("A", 0.3, UnicycleMotion(0.0, 0.7, 0.0, 0.0))
+    b = PredictedObstacle("B", 0.3, WaypointMotion(np.array(
+        [[0.0, 0.522, 0.0], [1.0, 2.522, 0.0], [39.901, 20.0, 0.0]])))
+    t0, t1 = 38.0, 43.0
+    assert b.motion.jump_times(t0, t1) == [39.901]
+    hold = Trajectory([HoldSegment(0.0, 0.0, 0.0, t0, t1)], kind="hold")
+
+    def brute(o):  # dense samples on each piece between the jumps
+        ts = np.concatenate([np.linspace(u, w, 200001) for u, w in o.motion.continuous_pieces(t0, t1)])
+        return float(np.min(np.hypot(*(hold.positions(ts) - o.positions(ts)).T))) - 0.3 - o.radius
+
+    truth = min(brute(a), brute(b))
+    assert truth == pytest.approx(-0.078, abs=1e-6)
+    for preds in ([a, b], [b, a], [b]):
+        clear = guard.clearance(hold, preds, t0, t1)
+        assert clear <= truth  # a lower bound (here the minimum, at the jump, exactly)
+        assert clear == pytest.approx(truth, abs=1e-6)
+        assert clear < guard.config.margin  # not clear by the margin
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 10_000))
+def test_clearance_of_open_tracks_is_a_lower_bound_on_random_cases(seed):
+    # open tracks whose jumps fall anywhere in the horizon, beside a parked disc
+    from anyplan.world.motion import WaypointMotion
+
+    rng = np.random.default_rng(seed)
+    guard = SafetyGuard(SPEC, ROOM)
+    t0 = float(rng.uniform(0.0, 20.0))
+    rest = RobotState(*rng.uniform([3.0, 3.0], [9.0, 5.0]), 0.0, 0.0, 0.0)
+    preds = [_parked_disc("A", rest.x + 1.2, rest.y)]
+    for k in range(3):
+        n = int(rng.integers(2, 4))
+        kt = np.concatenate([[0.0], np.cumsum(rng.uniform(0.3, 2.0, n - 1))])
+        pts = np.array([rest.x, rest.y]) + rng.uniform(-2.0, 2.0, (n, 2))
+        preds.append(PredictedObstacle(f"B{k}", 0.3, WaypointMotion(np.column_stack([kt, pts]))))
+    assert all(o.motion.may_jump for o in preds[1:])
+    (_, hold, t_rest), *_ = guard.candidates(t0, rest, preds)
+    t1 = max(t0 + guard.config.horizon_s, t_rest)
+    clear = guard.clearance(hold, preds, t0, t1)
+    truth = math.inf
+    for o in preds:
+        ts = np.concatenate([np.linspace(u, w, 50001) for u, w in o.motion.continuous_pieces(t0, t1)])
+        d = np.hypot(*(hold.positions(ts) - o.positions(ts)).T) - SPEC.radius - o.radius
+        truth = min(truth, float(d.min()))
+    # each piece's minimum is certified within L tol (closest_approach), the samples within
+    # L * 1e-4 (L the fastest obstacle's speed: the robot is at rest)
+    speed = max(o.max_speed for o in preds)
+    assert truth - speed * 1e-4 - 1e-9 <= clear <= truth + speed * guard.config.tol + 1e-9

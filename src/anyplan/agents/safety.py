@@ -31,7 +31,7 @@ from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.motion import brake_to_rest, come_to_rest, polyline_trajectory
 from anyplan.trajectory.reference import HoldSegment
 from anyplan.trajectory.trajectory import BrakeSegment, Trajectory
-from anyplan.world.motion import UnicycleMotion
+from anyplan.world.motion import JUMP_SLACK_S, UnicycleMotion
 from anyplan.world.robot import RobotSpec, RobotState
 
 __all__ = ["SafetyConfig", "Decision", "Escape", "SafetyGuard", "FALLBACK_KINDS", "reachable_discs",
@@ -287,7 +287,9 @@ class SafetyGuard:
         """Certified minimum distance [m] between the robot's disc on ``motion`` and every
         predicted disc over [t0, t1] [s] (inf without predictions; negative when they overlap).
         A disc whose radius grows with the horizon counts with its largest radius (a lower
-        bound on the clearance)."""
+        bound on the clearance). A motion that jumps (an open track) is searched piece by
+        piece between its jumps (:meth:`~anyplan.world.motion.Motion.continuous_pieces`): its
+        speed bound holds only there."""
         best = math.inf
         r = self.spec.radius
         p0 = motion.positions(np.array([t0]))[0]
@@ -305,6 +307,7 @@ class SafetyGuard:
             d[ts[None, :] > np.minimum(t1, until)[:, None] + 0.1] = math.inf
             lbs = 0.5 * (d[:, :-1] + d[:, 1:]
                          - (float(motion.max_speed) + vo)[:, None] * np.diff(ts)[None, :])
+            _unbound_jumps(lbs, preds, ts, until)
             gone = np.minimum(t1, until) < t0
             lows = np.where(gone, math.inf, lbs.min(axis=1))
             dm = np.where(gone, math.inf, d.min(axis=1))
@@ -316,15 +319,17 @@ class SafetyGuard:
             t1o = min(t1, float(getattr(o, "until", math.inf)))  # up to the prediction's horizon
             if t1o < t0:
                 continue
-            q0 = o.positions(np.array([t0]))[0]
             speed = float(motion.max_speed) + float(o.max_speed)
             ro = _max_radius(o)
-            lb = math.hypot(*(p0 - q0)) - speed * (t1o - t0) - r - ro
-            if lb >= best:
-                continue  # cannot come closer than the best so far
-            _, d = closest_approach(motion.positions, o.positions, speed, t0, t1o,
-                                    tol=self.config.tol)
-            best = min(best, d - r - ro)
+            for a, b in _continuous_pieces(o, t0, t1o):  # [(t0, t1o)] without a jump
+                pa = p0 if a == t0 else motion.positions(np.array([a]))[0]
+                qa = o.positions(np.array([a]))[0]
+                lb = math.hypot(*(pa - qa)) - speed * (b - a) - r - ro
+                if lb >= best:
+                    continue  # cannot come closer than the best so far
+                _, d = closest_approach(motion.positions, o.positions, speed, a, b,
+                                        tol=self.config.tol)
+                best = min(best, d - r - ro)
         return best
 
     def _tracks_at(self, preds: Sequence[PredictedObstacle], ts: np.ndarray) -> _Tracks:
@@ -457,6 +462,34 @@ def _tracks(preds: Sequence[PredictedObstacle], ts: np.ndarray) -> _Tracks:
     vo = np.array([float(o.max_speed) for o in preds])
     until = np.array([float(getattr(o, "until", math.inf)) for o in preds])
     return q, ro, vo, until
+
+
+def _motion_that_jumps(o: Any) -> Any:
+    """The motion of prediction ``o`` if it may jump (an open track), else None."""
+    m = getattr(o, "motion", None)
+    return m if m is not None and getattr(m, "may_jump", False) else None
+
+
+def _continuous_pieces(o: Any, t0: float, t1: float) -> list[tuple[float, float]]:
+    """[t0, t1] [s] cut at the jumps of ``o``'s motion (:meth:`Motion.continuous_pieces`);
+    ``[(t0, t1)]`` for a motion that never jumps."""
+    m = _motion_that_jumps(o)
+    return [(t0, t1)] if m is None else m.continuous_pieces(t0, t1)
+
+
+def _unbound_jumps(lbs: np.ndarray, preds: Sequence[PredictedObstacle], ts: np.ndarray,
+                   until: np.ndarray) -> None:
+    """Set to -inf the lower bounds ``lbs`` (n, len(ts) - 1) [m] of the grid intervals of
+    ``ts`` [s] that hold (within :data:`JUMP_SLACK_S`) a jump of a prediction up to its
+    horizon ``until`` [s]: a speed bound does not hold across a jump."""
+    for k, o in enumerate(preds):
+        m = _motion_that_jumps(o)
+        if m is None:
+            continue
+        for jt in m.jump_times(float(ts[0]) - JUMP_SLACK_S, min(float(ts[-1]), float(until[k]))):
+            i0 = int(np.searchsorted(ts, jt - JUMP_SLACK_S)) - 1
+            i1 = int(np.searchsorted(ts, jt + JUMP_SLACK_S, side="right"))
+            lbs[k, max(i0, 0):max(min(i1, lbs.shape[1]), 0)] = -math.inf
 
 
 def _max_radius(o: Any) -> float:
