@@ -2,10 +2,11 @@
 
 STRRT* plans in (x, y, t) for a holonomic point robot with |v| <= v_max, minimising the arrival
 time, given the static obstacles and the true motions of the moving ones, with exact validity
-checks (states and motions, the latter by :func:`anyplan.geometry.first_contact`). Only the
-``ompl`` 1.7 wheels expose it (``pip install 'anyplan[strrt]'``); each problem is solved in a
-fresh subprocess (``python -m anyplan.experiments.strrt``, JSON in and out) because of the
-wheel's import-order and exit traps.
+checks (states and motions, the latter by :func:`anyplan.geometry.first_contact`, between the
+jumps of an open track). Only the ``ompl`` 1.7 wheels expose it
+(``pip install 'anyplan[strrt]'``); each problem is solved in a fresh subprocess
+(``python -m anyplan.experiments.strrt``, JSON in and out) because of the wheel's import-order
+and exit traps.
 
 Validity checks and the subprocess protocol: ``docs/spacetime.md``, "STRRT*: how it is run".
 """
@@ -68,6 +69,31 @@ def solve_strrt(scenario: Scenario, budget_s: float, seed: int = 0, site: str | 
     return {"solved": False, "error": (out.stderr.strip().splitlines() or ["no output"])[-1]}
 
 
+def _clear_of_movers(movers: list[tuple[Any, float]], radius: float, sa: tuple[float, float, float],
+                     sb: tuple[float, float, float], v: float) -> bool:
+    """True if a robot disc of ``radius`` [m] moving straight from ``sa`` to ``sb`` (x [m],
+    y [m], t [s]) at speed ``v`` [m/s] touches no mover, (motion, radius [m]), on the way:
+    :func:`~anyplan.geometry.moving.first_contact` on each continuous piece of a mover's
+    motion, where its speed bound holds (an open track jumps: ``Motion.continuous_pieces``)."""
+    import numpy as np
+
+    from anyplan.geometry.moving import first_contact
+
+    (xa, ya, ta), (xb, yb, tb) = sa, sb
+    pa, pb = np.array([xa, ya]), np.array([xb, yb])
+
+    def robot(t: np.ndarray) -> np.ndarray:
+        u = ((np.asarray(t, dtype=float) - ta) / (tb - ta))[:, None]
+        return pa + u * (pb - pa)
+
+    for m, rad in movers:
+        for a, b in m.continuous_pieces(ta, tb):  # [(ta, tb)] for a motion that never jumps
+            if first_contact(robot, m.positions, v + m.max_speed, radius + rad, a, b,
+                             tol=1e-4) is not None:
+                return False
+    return True
+
+
 def _worker(problem: dict[str, Any]) -> dict[str, Any]:  # pragma: no cover - runs in a subprocess
     import time
 
@@ -76,7 +102,6 @@ def _worker(problem: dict[str, Any]) -> dict[str, Any]:  # pragma: no cover - ru
     from ompl import geometric as og
     from ompl import util as ou
 
-    from anyplan.geometry.moving import first_contact
     from anyplan.world.scenario import scenario_from_dict
 
     sc = scenario_from_dict(problem["scenario"], "<strrt problem>")
@@ -122,17 +147,7 @@ def _worker(problem: dict[str, Any]) -> dict[str, Any]:  # pragma: no cover - ru
                 return False
             if d > 0.0 and not statics.segment_free((xa, ya), (xb, yb), r.radius):
                 return False
-            pa, pb = np.array([xa, ya]), np.array([xb, yb])
-
-            def robot(t: np.ndarray) -> np.ndarray:
-                u = ((np.asarray(t, dtype=float) - ta) / (tb - ta))[:, None]
-                return pa + u * (pb - pa)
-
-            for m, rad in movers:
-                if first_contact(robot, m.positions, v + m.max_speed, r.radius + rad, ta, tb,
-                                 tol=1e-4) is not None:
-                    return False
-            return True
+            return _clear_of_movers(movers, r.radius, (xa, ya, ta), (xb, yb, tb), v)
 
     si.setStateValidityChecker(ob.StateValidityCheckerFn(valid))
     mv = Exact(si)
