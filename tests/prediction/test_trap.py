@@ -131,3 +131,54 @@ def test_skipping_the_search_when_trapped_changes_no_decision_tracked(monkeypatc
 @pytest.mark.parametrize("mode", ["twist", "oracle"])
 def test_skipping_the_search_when_trapped_changes_no_decision(mode, monkeypatch):
     _same_decisions(mode, monkeypatch)
+
+
+def _first_held(o, t0, speed, horizon_s, step_s=0.02):
+    """first_trap's grid test for one obstacle at every grid time (no pre-filter), by hand."""
+    from anyplan.prediction.trap import _DIST_SLACK, _LIMIT_FACTOR, _SPEED_SLACK
+
+    tau = np.arange(0.0, horizon_s + 0.5 * step_s, step_s)
+    d = reach_m(min(speed + _SPEED_SLACK, _LIMIT_FACTOR * V_MAX), _LIMIT_FACTOR * V_MAX,
+                _LIMIT_FACTOR * A_MAX, tau) + _DIST_SLACK
+    t = t0 + tau
+    q = o.positions(t)
+    held = (np.hypot(q[:, 0], q[:, 1]) + d < RADIUS + float(o.radius) + MARGIN) \
+        & (d < RADIUS + MARGIN + float(o.radius))
+    return float(t[np.argmax(held)]) if held.any() else None
+
+
+def test_an_open_track_that_jumps_onto_the_robot_traps_it():
+    # B's open track starts on the robot (at the origin), walks away at 0.5 m/s for 40 s and
+    # jumps back. From t0 = 39.9 (B 19.95 m away) its speed bound says it cannot come near
+    # within the trap's horizon, but at t = 40 it lands on the robot: the robot is trapped.
+    from anyplan.world.motion import WaypointMotion
+
+    b = PredictedObstacle("B", 0.5, WaypointMotion(np.array([[0.0, 0.0, 0.0], [40.0, 20.0, 0.0]])))
+    assert b.motion.jump_times(39.9, 50.0) == [40.0]
+    trap = first_trap([b], (0.0, 0.0), 0.0, 39.9, RADIUS, V_MAX, A_MAX, MARGIN, 10.0)
+    assert trap is not None and trap.obstacle == "B"
+    assert trap.t == pytest.approx(40.0) == _first_held(b, 39.9, 0.0, 10.0)
+    # from just before a later jump, and from the jumps themselves, likewise
+    for t0 in (79.99, 40.0, 80.0):
+        trap = first_trap([b], (0.0, 0.0), 0.0, t0, RADIUS, V_MAX, A_MAX, MARGIN, 10.0)
+        assert trap is not None and trap.t == _first_held(b, t0, 0.0, 10.0)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(0.0, 0.4), st.floats(-3.1, 3.1), st.floats(0.2, 3.0), st.floats(2.0, 12.0),
+       st.integers(1, 5), st.floats(0.0, 1.5), st.floats(0.0, 0.5))
+def test_the_pre_filter_keeps_every_open_track_that_traps(near, bearing, dwell, leave, n, before,
+                                                          speed):
+    # An open track lands within `near` of the robot, dwells, then leaves for 15 m away and
+    # jumps back: first_trap finds the first held grid time of every grid time tested by hand.
+    from anyplan.world.motion import WaypointMotion
+
+    a = np.array([near * math.cos(bearing), near * math.sin(bearing)])
+    far = a + 15.0 * np.array([math.cos(bearing + 1.0), math.sin(bearing + 1.0)])
+    m = WaypointMotion(np.array([[0.0, *a], [dwell, *(a + 0.05)], [dwell + leave, *far]]))
+    o = PredictedObstacle("B", 0.5, m)
+    t0 = n * m.period - before
+    got = first_trap([o], (0.0, 0.0), speed, t0, RADIUS, V_MAX, A_MAX, MARGIN, 3.0)
+    want = _first_held(o, t0, speed, 3.0)
+    assert (got is None) == (want is None)
+    assert got is None or got.t == want

@@ -27,6 +27,8 @@ __all__ = ["Trap", "first_trap", "reach_m"]
 _SPEED_SLACK = 0.02
 _LIMIT_FACTOR = 1.01
 _DIST_SLACK = 1e-3
+#: [s] how long before t0 a jump is still taken into account (rounding: a jump at t0 counts).
+_JUMP_BEFORE_S = 1e-6
 
 
 def reach_m(speed: float, v_max: float, a_max: float, tau: np.ndarray) -> np.ndarray:
@@ -95,9 +97,12 @@ def first_trap(preds: Sequence[PredictedObstacle], position: tuple[float, float]
     p = np.array(position, dtype=float)
     best: Trap | None = None
     for o in preds:
-        # the disc must come within `widest` of the robot while its reach is that small
+        # the disc must come within `widest` of the robot while its reach is that small: from
+        # where it is at t0, or, for a motion that jumps, from where it lands at a jump (its
+        # speed bound holds only between jumps)
         qx, qy = o.motion.position(t0)  # a straight motion's in scalars
-        if math.hypot(qx - p[0], qy - p[1]) - float(o.max_speed) * float(tau[-1]) >= widest + 1e-6:
+        if math.hypot(qx - p[0], qy - p[1]) - float(o.max_speed) * float(tau[-1]) >= widest + 1e-6 \
+                and not _lands_near(o, p, t0, float(t[-1]), float(tau[-1]), widest):
             continue
         q = np.asarray(o.positions(t), dtype=float).reshape(-1, 2)
         r = np.asarray(o.radius_at(t), dtype=float)
@@ -107,3 +112,15 @@ def first_trap(preds: Sequence[PredictedObstacle], position: tuple[float, float]
             if best is None or t[k] < best.t:
                 best = Trap(float(t[k]), str(o.name))
     return best
+
+
+def _lands_near(o: PredictedObstacle, p: np.ndarray, t0: float, t1: float, span: float,
+                widest: float) -> bool:
+    """True if ``o``'s motion jumps in [t0, t1] [s] to a place from which it may come within
+    ``widest`` [m] of ``p`` [m] in ``span`` [s] (no jump: False). A jump at t0 counts: the
+    position there may round to either side of it."""
+    if not o.motion.may_jump:
+        return False
+    v = float(o.max_speed)
+    return any(math.hypot(float(j.after[0]) - p[0], float(j.after[1]) - p[1]) - v * span
+               < widest + 1e-6 for j in o.motion.jumps(t0 - _JUMP_BEFORE_S, t1))
