@@ -9,7 +9,9 @@ import pytest
 from scipy.interpolate import CubicSpline, make_interp_spline
 
 from anyplan.geometry import Circle, ObstacleSet
+from anyplan.geometry.collision import COLLISION_EPS
 from anyplan.trajectory.spline import START_KNOT, SmoothCurve, clean_path, shortcut_path
+from anyplan.trajectory.spline._clearance import CAP_DELTA
 from anyplan.trajectory.spline._fit import cubic_spline
 from anyplan.trajectory.spline._pp import pp_eval
 from anyplan.trajectory.spline.clearance import failing_pieces, worst_failures, worst_per_group
@@ -169,6 +171,11 @@ def test_branch_and_bound_on_maps_finds_the_same_worst_pieces(seed):
         again = worst_failures(c, obs, radius, 4)
         assert [a.tolist() for a in again[:3]] == [ks.tolist(), bu.tolist(), bc.tolist()]
         assert again[3] == bmargin or (math.isinf(bmargin) and math.isinf(again[3]))
+        # without the tight margin: the same failures, and the margin capped at CAP_DELTA
+        # (the deferred pieces, never measured, clear it)
+        loose = worst_failures(c, obs, radius, 4, tight=False)
+        assert [a.tolist() for a in loose[:3]] == [ks.tolist(), bu.tolist(), bc.tolist()]
+        assert loose[3] == min(bmargin, (radius - COLLISION_EPS) + CAP_DELTA - radius)
 
 
 def test_smoothing_memo_answers_as_a_fresh_smoothing():

@@ -275,7 +275,7 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
     # that the reference turn rate does not jump at the start.
     k0 = state.omega / v0 if v0 > _V_CURVATURE else math.inf
     res = smooth_path(pts, obstacles, radius, start_heading=state.theta, max_rounds=max_repair_rounds,
-                      grid_step=grid_step,
+                      grid_step=grid_step, tight_margin=False,
                       start_curvature=k0 if abs(k0) <= _MAX_START_CURVATURE else None)
     if res.curve is not None:
         prof = time_parameterize(res.curve, spec, v0)
@@ -291,7 +291,7 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         tr = Trajectory([seg_a], kind=MotionKind.SMOOTH, feasible=ok_a,
                         lower_bound_s=time_lower_bound(res.curve.length, spec, v0), polyline=pts,
                         info={"repair_rounds": res.rounds, "points_added": res.points_added,
-                              "certified_margin_m": res.margin})
+                              "certified_margin_m": res.margin})  # a lower bound, <= 5 cm
         cands.append((ok_a, tr.duration, tr))
         info["candidates"]["smooth"] = tr.duration if ok_a else math.inf
 
@@ -324,7 +324,8 @@ def plan_motion(path: np.ndarray, spec: RobotSpec, state: RobotState, obstacles:
         if a_wins:
             info["pruned"] = {"turn+smooth": bound - t_start}
         res_b = None if a_wins else smooth_path(pts_b, obstacles, radius, start_heading=target,
-                                                max_rounds=max_repair_rounds, grid_step=grid_step)
+                                                max_rounds=max_repair_rounds, grid_step=grid_step,
+                                                tight_margin=False)
         if res_b is not None and res_b.curve is not None and brake_free:
             prof = time_parameterize(res_b.curve, spec, 0.0)
             segs.append(CurveSegment(res_b.curve, prof, t))

@@ -248,7 +248,8 @@ def argsort_stable(v: np.ndarray) -> np.ndarray:
 
 @njit(cache=True)
 def certify_worst(cv: CurveArrays, limit: float, radius: float, max_depth: int,
-                  obs: ObstacleArrays) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+                  obs: ObstacleArrays, tight: bool = True
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """:func:`certify` reduced to what the repair uses, by branch and bound.
 
     Returns, for each interpolation interval k (``point_u[k:k+2]``) that has a piece failing at
@@ -266,6 +267,10 @@ def certify_worst(cv: CurveArrays, limit: float, radius: float, max_depth: int,
     values and is skipped. Every grid piece is tested first; the failing ones are then searched from the
     lowest certified clearance up, and each piece's failing children likewise, so that the best
     is found early.
+
+    With ``tight`` False the deferred pieces are never measured: the margin is then
+    min(the margin of the measured pieces, limit + CAP_DELTA - radius), still a certified lower
+    bound (every deferred piece clears limit + CAP_DELTA), and the failures are the same.
 
     Fewer and cheaper queries, same answers: the chord clearance is capped at limit + dev +
     :data:`CAP_DELTA` (a piece clearing that is certified; it is measured, capped by the margin
@@ -433,7 +438,9 @@ def certify_worst(cv: CurveArrays, limit: float, radius: float, max_depth: int,
         if has[k]:
             free = False
             break
-    if free and nd > 0 and margin > limit + CAP_DELTA - radius - 1e-9:
+    if not tight:
+        margin = min(margin, limit + CAP_DELTA - radius)
+    elif free and nd > 0 and margin > limit + CAP_DELTA - radius - 1e-9:
         hint = np.int64(0)
         for j in range(nd):
             pax, pay, pbx, pby, dev, hint = chord_dev_one(x, c, dfa[j], dfb[j], hint)

@@ -32,15 +32,17 @@ def failing_pieces(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
     return curve.point_index(fail_u), fail_u, fail_c, margin
 
 
-def worst_failures(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,
-                    max_depth: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+def worst_failures(curve: SmoothCurve, obstacles: ObstacleSet, radius: float, max_depth: int,
+                   tight: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """What the repair uses of :func:`failing_pieces`: per interpolation interval with failing pieces,
     its first failing piece of least certified clearance (k, midpoint u, clearance), found by
-    branch and bound (see ``_clearance.certify_worst``); the margin is valid when nothing fails.
+    branch and bound (see ``_clearance.certify_worst``); the margin is valid when nothing fails
+    (with ``tight`` False a certified lower bound of it, at most ``CAP_DELTA`` (5 cm), cheaper on
+    a curve far from every obstacle).
     Not memoised: :func:`~anyplan.trajectory.spline.smooth.smooth_path` memoises whole
     smoothings, and a curve certified twice outside that memo is rare (1-2 % of the calls)."""
     return _clearance.certify_worst(curve.arrays, radius - COLLISION_EPS, float(radius),
-                                    int(max_depth), obstacles.arrays)
+                                    int(max_depth), obstacles.arrays, bool(tight))
 
 
 def curve_clearance_ok(curve: SmoothCurve, obstacles: ObstacleSet, radius: float,

@@ -37,7 +37,8 @@ class SmoothingResult:
             cusp (see :meth:`SmoothCurve.is_regular`).
         rounds: Repair rounds used (0: the first spline was free).
         points_added: Interpolation points inserted by the repair.
-        margin: Certified clearance above the required radius [m] (nan if no curve).
+        margin: Certified clearance above the required radius [m] (nan if no curve); with
+            ``tight_margin`` False a certified lower bound of it, at most 5 cm.
     """
 
     curve: SmoothCurve | None
@@ -73,7 +74,8 @@ MAX_SEGMENT_M = 25.0
 def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
                 start_heading: float | None = None, max_rounds: int = 10,
                 grid_step: float = 0.02, min_segment: float = 0.02,
-                repair: str = "project", start_curvature: float | None = None) -> SmoothingResult:
+                repair: str = "project", start_curvature: float | None = None,
+                tight_margin: bool = True) -> SmoothingResult:
     """Fit a cubic spline through ``path`` and repair it until it is certified collision-free.
 
     Args:
@@ -90,6 +92,8 @@ def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
         repair: ``"project"`` (default): in each interval that is not certified, insert the
             projection of its worst point onto the polyline segment (clamped to the middle 60 %
             of the segment); ``"midpoint"``: split that segment and both neighbours in half.
+        tight_margin: False: the result's margin is a certified lower bound, at most 5 cm
+            (``worst_failures``), instead of the tightest one; the curve is the same.
 
     Returns:
         A :class:`SmoothingResult`; ``curve`` is None when no certified curve was found.
@@ -98,13 +102,14 @@ def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
     h.update(obstacles.fingerprint)
     h.update(repr((np.shape(path), float(radius), None if start_heading is None else float(start_heading),
                    int(max_rounds), float(grid_step), float(min_segment), repair,
-                   None if start_curvature is None else float(start_curvature))).encode())
+                   None if start_curvature is None else float(start_curvature),
+                   bool(tight_margin))).encode())
     key = h.digest()
     for k, ans in _MEMO:
         if k == key:
             return SmoothingResult(ans.curve, ans.rounds, ans.points_added, ans.margin)
     out = _smooth_path(path, obstacles, radius, start_heading, max_rounds, grid_step, min_segment,
-                       repair, start_curvature)
+                       repair, start_curvature, tight_margin)
     _MEMO.append((key, out))
     del _MEMO[:-_MEMO_SIZE]
     return SmoothingResult(out.curve, out.rounds, out.points_added, out.margin)
@@ -112,8 +117,8 @@ def smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
 
 def _smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
                  start_heading: float | None, max_rounds: int, grid_step: float,
-                 min_segment: float, repair: str, start_curvature: float | None
-                 ) -> SmoothingResult:
+                 min_segment: float, repair: str, start_curvature: float | None,
+                 tight_margin: bool = True) -> SmoothingResult:
     pts = clean_path(path)
     if len(pts) < 2:
         raise ValueError("path must contain two distinct points")
@@ -127,7 +132,7 @@ def _smooth_path(path: np.ndarray, obstacles: ObstacleSet, radius: float,
         if not curve.is_regular():
             # a cusp comes from the start heading, which no repair changes
             return SmoothingResult(None, rnd, len(pts) - n0, float("nan"))
-        kk, fu, fc, margin = worst_failures(curve, obstacles, radius, 4)
+        kk, fu, fc, margin = worst_failures(curve, obstacles, radius, 4, tight_margin)
         if len(kk) == 0:
             return SmoothingResult(curve, rnd, len(pts) - n0, margin)
         grew = grew + 1 if failing >= 0 and len(kk) > failing else 0
