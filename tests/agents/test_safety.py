@@ -238,6 +238,13 @@ def check_invariant(scenario, agent, result):
                 # (an escape brakes at the end of its motion at the latest)
                 assert d.t_commit >= min(t_act, tr.t_end) - 1e-9, (d, t_act)
                 assert _escape_free(tr, d.t, t_act, spec, obst, preds), d
+        elif d.rule == "give_way":  # a stoppable motion gave way (seq-bitstar's give_way)
+            assert fallbacks[n_fb]["t"] == d.t and fallbacks[n_fb]["kind"] == d.kind
+            n_fb += 1
+            assert d.first_collision_s is not None and d.first_collision_s - d.t <= 5.0 + 1e-9
+            if d.safe:
+                assert first_collision(tr, preds, spec.radius, t_from=d.t,
+                                       t_until=max(tr.t_end, d.t + 5.0)) is None, d
         else:
             assert d.kind in FALLBACK_KINDS
             assert fallbacks[n_fb]["t"] == d.t and fallbacks[n_fb]["kind"] == d.kind

@@ -187,3 +187,51 @@ def test_a_safety_decision_ready_after_its_switch_time_is_made_from_the_later_st
         assert t_switch - t_call >= slow - 1e-9
         assert float(tr.t_start) == pytest.approx(t_switch)
     assert r.extra["late_plans"] >= len(calls)
+
+
+def _seq_agent_in_empty_room(**options):
+    """seq-bitstar, reset in the crossing scenario's 12 m x 6 m room without its obstacle."""
+    from anyplan.world.scenario import scenario_from_dict
+    from tests.agents.test_spacetime_agent import _crossing_scenario
+
+    data = _crossing_scenario().to_dict()
+    data["robot"].update(v_max=1.0, omega_max=1.0, a_max=1.0, alpha_max=2.0)
+    data["dynamic_obstacles"] = []
+    agent = make_agent("seq-bitstar", **options)
+    agent.reset(scenario_from_dict(data), np.random.default_rng(0))
+    return agent
+
+
+@pytest.mark.parametrize("heading_at_robot", [True, False])
+def test_a_stoppable_motion_struck_soon_gives_way_to_a_free_evasion(heading_at_robot):
+    # A robot at rest that turns in place (stoppable: it is at rest all along), and an obstacle
+    # known exactly (a constant twist, no growth) walking at it, 2 s away: holding there is
+    # struck, so the agent gives way to a fallback that no prediction strikes, and logs it. An
+    # obstacle that passes 2 m away strikes nothing: the guard's decision stands.
+    import math
+
+    from anyplan.agents.safety import Decision
+    from anyplan.prediction import PredictedObstacle
+    from anyplan.prediction.collision import first_collision
+    from anyplan.world import RobotState, UnicycleMotion
+
+    agent = _seq_agent_in_empty_room()
+    state = RobotState(4.0, 3.0, 0.0, 0.0, 0.0)
+    turn, _ = agent.reference.hold(state, 0.0, 8.0, kind="hold")
+    y0 = 3.0 if heading_at_robot else 5.0
+    preds = [PredictedObstacle("W", 0.25, UnicycleMotion(8.5, y0, math.pi, 1.0))]
+    hit = first_collision(turn, preds, agent.spec.radius, margin=agent.guard.config.margin)
+    assert (hit is not None) == heading_at_robot
+    dec = Decision(0.0, "motion", turn, True, "stoppable", 0.0, 0.0,
+                   None if hit is None else hit.t)
+    n_logged = len(agent.guard.fallbacks)
+    out = agent._give_way(dec, state, preds)
+    if not heading_at_robot:
+        assert out is dec and len(agent.guard.fallbacks) == n_logged
+        return
+    assert out.kind not in ("motion", "keep") and out.rule == "give_way" and out.safe
+    assert first_collision(out.trajectory, preds, agent.spec.radius, t_from=0.0, t_until=5.0,
+                           margin=agent.guard.config.margin) is None
+    assert agent.guard.fallbacks[-1]["kind"] == out.kind and len(agent.guard.fallbacks) == n_logged + 1
+    with pytest.raises(ValueError, match="give_way"):
+        make_agent("seq-bitstar", give_way=True)

@@ -114,7 +114,9 @@ class Decision:
         trajectory: What the robot executes from ``t``.
         safe: True when ``trajectory`` satisfies the rule from ``t`` (free to rest, or stoppable);
             for a fallback, when its moving part is predicted collision-free.
-        rule: ``"free_to_rest"``, ``"stoppable"``, ``"fallback"`` or ``"unsafe"``.
+        rule: ``"free_to_rest"``, ``"stoppable"``, ``"fallback"``, ``"unsafe"``, or
+            ``"give_way"`` (an agent's fallback in place of a stoppable motion, e.g.
+            ``seq-bitstar``'s ``give_way``).
         t_commit: For ``stoppable``: the time [s] the escape starts braking.
         t_rest: Time [s] the robot is at rest on the checked motion (escape or fallback).
         first_collision_s: First predicted collision [s] of the proposed motion (None if free).

@@ -20,8 +20,9 @@ from typing import Any
 import numpy as np
 
 from anyplan.agents.base import Observation, checked_number, checked_pose_margin
+from anyplan.agents.evasion import FallbackRanker, freer_evasion
 from anyplan.agents.replanning import MAX_BACKOFF_S, ReplanningAgent
-from anyplan.agents.safety import SafetyConfig, SafetyGuard
+from anyplan.agents.safety import Decision, SafetyConfig, SafetyGuard, finite_or_none
 from anyplan.agents.stats import SequentialStats
 from anyplan.agents.warmup import warm_up_kernels
 from anyplan.control.kanayama import KanayamaGains
@@ -33,7 +34,10 @@ from anyplan.trajectory.reference import ReferenceBuilder
 from anyplan.trajectory.trajectory import Trajectory
 from anyplan.world.scenario import Scenario
 
-__all__ = ["SequentialBITStarAgent", "MAX_BACKOFF_S"]
+__all__ = ["SequentialBITStarAgent", "MAX_BACKOFF_S", "GIVE_WAY"]
+
+#: The choices of ``give_way`` (:class:`SequentialBITStarAgent`).
+GIVE_WAY = ("announced", "always", "never")
 
 
 class SequentialBITStarAgent(ReplanningAgent):
@@ -62,6 +66,15 @@ class SequentialBITStarAgent(ReplanningAgent):
         reanchor_m: Tracking error [m] beyond which the next motion starts from the robot's
             own state (:class:`~anyplan.agents.replanning.ReplanningAgent`); None: never.
         max_delay_s: Cap [s] on a measured planning delay; None: the loop's ``max_time_s``.
+        give_way: When a motion the guard accepts as *stoppable* (it can brake before its
+            predicted collision) is struck within the guard's ``horizon_s``, it gives way to
+            the best fallback (the guard's, 8 evasions, swerves:
+            :func:`~anyplan.agents.evasion.freer_evasion`) that is free of the predictions
+            where the motion is not: braking on it would stand the robot where the obstacle
+            passes (as ``st-bitstar`` does). ``"announced"`` (default): only while every
+            obstacle in view announces its motion (exact predictions); ``"always"``: with
+            extrapolated twists too (on DynaBARN more arrivals and more robot-caused
+            collisions: ``docs/sequential.md``); ``"never"``: the guard's decision stands.
     """
 
     name = "seq-bitstar"
@@ -81,7 +94,7 @@ class SequentialBITStarAgent(ReplanningAgent):
                  gains: KanayamaGains | None = None, safety: bool = True,
                  safety_config: SafetyConfig | None = None, reanchor_m: float | None = 0.2,
                  pose_margin_m: float = 0.0, max_delay_s: float | None = None,
-                 **loop_options: Any) -> None:
+                 give_way: str = "announced", **loop_options: Any) -> None:
         if config is None:
             config = SequentialConfig(**loop_options)
         elif loop_options:
@@ -100,6 +113,9 @@ class SequentialBITStarAgent(ReplanningAgent):
         self.pose_margin_m = pose_margin_m
         self.grid_step = checked_number("grid_step", grid_step, lo_open=True)
         self.safety = bool(safety)
+        if give_way not in GIVE_WAY:
+            raise ValueError(f"give_way: must be one of {', '.join(GIVE_WAY)}, got {give_way!r}")
+        self.give_way = give_way
         self.safety_config = safety_config or SafetyConfig(margin=config.margin,
                                                            recheck_margin=0.5 * config.margin)
 
@@ -186,6 +202,8 @@ class SequentialBITStarAgent(ReplanningAgent):
         state the robot has when it is ready (the motion re-timed from there), as a late plan
         is re-timed (:meth:`_take_up`); it counts as a late plan."""
         current, planned = self._in_use(), t_switch
+        give_way = self.give_way == "always" or (
+            self.give_way == "announced" and all(o.motion is not None for o in obs.obstacles))
 
         def decide(t_s: float) -> tuple[Any, bool]:
             # Before the agent can act again: one check period, then a replanning's delay.
@@ -194,6 +212,9 @@ class SequentialBITStarAgent(ReplanningAgent):
             m = motion if t_s == planned or motion is None else self.reference.departing(
                 state, t_s)(res.path, [v.shape for v in res.virtual_obstacles], res.delay_s)
             dec = self.guard.decide(t_s, m, current, state, preds, self._commit_s)
+            if (give_way and dec.rule == "stoppable" and dec.first_collision_s is not None
+                    and dec.first_collision_s - t_s <= self.guard.config.horizon_s):
+                dec = self._give_way(dec, state, preds)
             return dec, dec.kind != "keep"
 
         t_switch, dec = self._decide_in_time(obs, t_switch, dt, decide,
@@ -205,6 +226,35 @@ class SequentialBITStarAgent(ReplanningAgent):
             self._record_plan(obs.t, t_switch, res)
         self._fallback_active = dec.kind not in ("motion", "keep")
         self.pending = (t_switch, dec.trajectory)
+
+    def _give_way(self, dec: Decision, state: Any, preds: list[PredictedObstacle]) -> Decision:
+        """``dec`` (a stoppable motion or keep), or the fallback that is free of the predictions
+        where it is not (:func:`~anyplan.agents.evasion.freer_evasion`; the predictions are
+        certain here: the full and the planned discs are the same), logged in its place (rule
+        ``"give_way"``; ``safe``: predicted collision-free over the guard's horizon)."""
+        ranker = FallbackRanker(self.spec, self.obstacles, self.guard, self.check_period_s,
+                                swerves=True)
+        better = freer_evasion(ranker, dec.t, state, preds, preds, dec.trajectory)
+        if better is None:
+            return dec
+        kind, tr, clear = better
+        cfg = self.guard.config
+        free = first_collision(tr, preds, self.spec.radius, t_from=dec.t,
+                               t_until=max(dec.t + cfg.horizon_s, float(tr.t_end)),
+                               margin=cfg.margin, sample_dt=cfg.sample_dt) is None
+        out = Decision(dec.t, kind, tr, free, "give_way", first_collision_s=dec.first_collision_s,
+                       predicted_clearance_m=clear,
+                       reason=f"{dec.kind}: stoppable, collision predicted at "
+                              f"{dec.first_collision_s:.2f} s; an evasion is free")
+        log = self.guard.decisions
+        if log and log[-1] is dec:
+            log[-1] = out  # one decision per replanning, as the guard logs it
+        else:
+            log.append(out)
+        self.guard.fallbacks.append({"t": float(dec.t), "kind": kind,
+                                     "predicted_clearance_m": finite_or_none(clear),
+                                     "reason": out.reason})
+        return out
 
     # --- checks ----------------------------------------------------------------------------------
     def _check(self, obs: Observation, preds: list[PredictedObstacle]) -> None:
