@@ -231,3 +231,25 @@ def test_recorded_tracks_are_drawn_only_while_they_exist(tmp_path, saved):
     assert xs.min() == pytest.approx(1.0, abs=0.11) and xs.max() == pytest.approx(3.0, abs=0.11)
     t_end = res["trajectory"][-1][0]
     assert len(xs) == pytest.approx(2.0 / 0.1 + 1, abs=2) and t_end > 4.0
+
+
+def test_an_open_track_is_drawn_without_its_jump_back(tmp_path, saved):
+    # An open waypoints track jumps back to its first keyframe each period: its dashed line
+    # breaks there instead of drawing the jump as a motion (no segment joins the two ends).
+    from tests.conftest import small_scenario_dict
+
+    sc = scenario_from_dict(small_scenario_dict(
+        arena={"width": 20.0, "height": 6.0}, static_obstacles=[], dynamic_obstacles=[
+            {"name": "J", "type": "waypoints", "radius": 0.3,
+             "keyframes": [[0.0, 4.0, 1.0], [6.0, 16.0, 1.0], [7.0, 16.0, 5.0]]}]))
+    assert sc.moving_obstacles[0].motion.may_jump
+    res = simulate(sc, make_agent("straight"), seed=0).to_dict()
+    assert res["trajectory"][-1][0] > 7.5  # the run outlasts J's first period
+    viz_run.save_run_figure(sc, res, tmp_path / "run.png")
+    fig, _ = saved["run.png"]
+    (line,) = [ln for ln in fig.axes[0].lines if ln.get_linestyle() == "--"]
+    xy = np.asarray(line.get_xydata(), dtype=float)
+    gaps = np.flatnonzero(np.isnan(xy[:, 0]))
+    assert len(gaps) >= 1
+    steps = np.hypot(*np.diff(xy, axis=0).T)
+    assert np.nanmax(steps) < 1.0  # the 12 m jump back is not drawn

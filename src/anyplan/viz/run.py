@@ -173,7 +173,12 @@ def draw_run(ax: Any, scenario: Scenario, result: Any, *, marked_times: Sequence
         if not np.any(alive):
             continue
         p = o.motion.positions(ts[alive])
-        ax.plot(p[:, 0], p[:, 1], ls="--", lw=0.9, color=col, zorder=3)
+        line = p
+        if o.motion.may_jump:  # an open track's jump back is not a motion: break the line there
+            cut = np.searchsorted(ts[alive], o.motion.jump_times(float(ts[alive][0]),
+                                                                 float(ts[alive][-1])))
+            line = np.insert(p, cut, np.nan, axis=0)
+        ax.plot(line[:, 0], line[:, 1], ls="--", lw=0.9, color=col, zorder=3)
         for tm in times:
             if not o.motion.exists(tm):
                 continue
