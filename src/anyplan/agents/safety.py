@@ -26,7 +26,13 @@ from anyplan.config import setting, validate
 from anyplan.geometry.collision import ObstacleSet
 from anyplan.geometry.moving import closest_approach
 from anyplan.geometry.se2 import dot2
-from anyplan.prediction.base import PredictedObstacle, RadiusGrowth, centres_of
+from anyplan.prediction.base import (
+    PredictedObstacle,
+    RadiusGrowth,
+    centres_of,
+    continuous_pieces_of,
+    jump_times_of,
+)
 from anyplan.prediction.collision import first_collision
 from anyplan.trajectory.motion import brake_to_rest, come_to_rest, polyline_trajectory
 from anyplan.trajectory.reference import HoldSegment
@@ -323,7 +329,7 @@ class SafetyGuard:
                 continue
             speed = float(motion.max_speed) + float(o.max_speed)
             ro = _max_radius(o)
-            for a, b in _continuous_pieces(o, t0, t1o):  # [(t0, t1o)] without a jump
+            for a, b in continuous_pieces_of(o, t0, t1o):  # [(t0, t1o)] without a jump
                 pa = p0 if a == t0 else motion.positions(np.array([a]))[0]
                 qa = o.positions(np.array([a]))[0]
                 lb = math.hypot(*(pa - qa)) - speed * (b - a) - r - ro
@@ -466,29 +472,13 @@ def _tracks(preds: Sequence[PredictedObstacle], ts: np.ndarray) -> _Tracks:
     return q, ro, vo, until
 
 
-def _motion_that_jumps(o: Any) -> Any:
-    """The motion of prediction ``o`` if it may jump (an open track), else None."""
-    m = getattr(o, "motion", None)
-    return m if m is not None and getattr(m, "may_jump", False) else None
-
-
-def _continuous_pieces(o: Any, t0: float, t1: float) -> list[tuple[float, float]]:
-    """[t0, t1] [s] cut at the jumps of ``o``'s motion (:meth:`Motion.continuous_pieces`);
-    ``[(t0, t1)]`` for a motion that never jumps."""
-    m = _motion_that_jumps(o)
-    return [(t0, t1)] if m is None else m.continuous_pieces(t0, t1)
-
-
 def _unbound_jumps(lbs: np.ndarray, preds: Sequence[PredictedObstacle], ts: np.ndarray,
                    until: np.ndarray) -> None:
     """Set to -inf the lower bounds ``lbs`` (n, len(ts) - 1) [m] of the grid intervals of
     ``ts`` [s] that hold (within :data:`JUMP_SLACK_S`) a jump of a prediction up to its
     horizon ``until`` [s]: a speed bound does not hold across a jump."""
     for k, o in enumerate(preds):
-        m = _motion_that_jumps(o)
-        if m is None:
-            continue
-        for jt in m.jump_times(float(ts[0]) - JUMP_SLACK_S, min(float(ts[-1]), float(until[k]))):
+        for jt in jump_times_of(o, float(ts[0]) - JUMP_SLACK_S, min(float(ts[-1]), float(until[k]))):
             i0 = int(np.searchsorted(ts, jt - JUMP_SLACK_S)) - 1
             i1 = int(np.searchsorted(ts, jt + JUMP_SLACK_S, side="right"))
             lbs[k, max(i0, 0):max(min(i1, lbs.shape[1]), 0)] = -math.inf

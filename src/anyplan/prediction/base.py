@@ -5,14 +5,14 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
 from anyplan.world.motion import Motion, UnicycleMotion, positions_of
 
 __all__ = ["ObstacleObservation", "PredictedObstacle", "Predictor", "ConstantTwistPredictor",
-           "RadiusGrowth", "centres_of"]
+           "RadiusGrowth", "centres_of", "jump_times_of", "continuous_pieces_of"]
 
 
 def _normalised(taus: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -185,6 +185,27 @@ def centres_of(preds: Sequence[PredictedObstacle], t: np.ndarray) -> np.ndarray:
     :func:`~anyplan.world.motion.positions_of`); any object with ``positions`` may stand in
     for a prediction."""
     return positions_of([o.motion if type(o) is PredictedObstacle else o for o in preds], t)
+
+
+def _jumping_motion(o: Any) -> Any:
+    m = getattr(o, "motion", None)
+    return m if m is not None and getattr(m, "may_jump", False) else None
+
+
+def jump_times_of(o: Any, t0: float, t1: float) -> list[float]:
+    """Times [s] in (t0, t1] at which the position of prediction ``o`` jumps (an open track's
+    periods, :meth:`~anyplan.world.motion.Motion.jump_times`); none for a motion that never
+    jumps, or for a stand-in without a motion."""
+    m = _jumping_motion(o)
+    return [] if m is None else m.jump_times(t0, t1)
+
+
+def continuous_pieces_of(o: Any, t0: float, t1: float) -> list[tuple[float, float]]:
+    """[t0, t1] [s] cut at the jumps of prediction ``o``'s position
+    (:meth:`~anyplan.world.motion.Motion.continuous_pieces`: a speed bound holds on each);
+    ``[(t0, t1)]`` for a motion that never jumps, or for a stand-in without a motion."""
+    m = _jumping_motion(o)
+    return [(t0, t1)] if m is None else m.continuous_pieces(t0, t1)
 
 
 class Predictor(Protocol):

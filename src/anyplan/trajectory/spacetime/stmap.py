@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from anyplan.prediction.base import jump_times_of
 from anyplan.world.motion import JUMP_SLACK_S
 
 __all__ = ["STMap", "RowCache", "build_stmap", "radii_at"]
@@ -281,13 +282,6 @@ class STMap:
         return out
 
 
-def _jumps(o: Any, t0: float, t1: float) -> list[float]:
-    """Times [s] in (t0, t1] at which the position of ``o`` jumps (an open track's periods;
-    none for an obstacle without a motion that says so)."""
-    m = getattr(o, "motion", None)
-    return m.jump_times(t0, t1) if m is not None and getattr(m, "may_jump", False) else []
-
-
 def _pieces(o: Any, js: list[float], t_map: float, h: float, nfill: int, reach: np.ndarray,
             speed: float) -> tuple[np.ndarray, np.ndarray]:
     """An obstacle whose position jumps within the rows (at the times ``js`` [s]) as one entry
@@ -373,7 +367,7 @@ def build_stmap(points_at: Any, length: float, obstacles: Sequence[Any], robot_r
     spread = speed * h
     owner = np.arange(len(obstacles))
     t_end = t_map + nfill * h
-    jumps = {k: js for k, o in enumerate(obstacles) if (js := _jumps(o, t_map, t_end))}
+    jumps = {k: js for k, o in enumerate(obstacles) if (js := jump_times_of(o, t_map, t_end))}
     jumpy = list(jumps)
     if jumpy:  # each such obstacle as its pieces between jumps (_pieces)
         parts = [_pieces(obstacles[k], jumps[k], t_map, h, nfill, reach[k], float(speed[k]))
